@@ -1,0 +1,55 @@
+#pragma once
+// Clip: sampled local joint transforms at a fixed frame rate, frame-major (all joints of frame 0,
+// then frame 1, ...) so that sampling one time touches two contiguous blocks. The root joint's
+// translation carries the root motion in metres (zero horizontal motion for in-place clips).
+// Immutable once built.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "animation/skeleton.h"
+
+namespace gk {
+
+struct Clip {
+  std::string name;
+  std::string source;  // file it came from, or "builtin"
+  float fps = 30.0f;
+  int num_frames = 0;
+  int num_joints = 0;
+  // [frame * num_joints + joint]
+  std::vector<glm::quat> rotations;
+  std::vector<glm::vec3> translations;
+  // Loop clips are sampled with wrap-around: frame num_frames-1 is followed by frame 0 (loaders drop
+  // a final frame that duplicates the first).
+  bool loops = true;
+
+  float duration_s() const {
+    return loops ? num_frames / fps : (num_frames > 1 ? (num_frames - 1) / fps : 0.0f);
+  }
+  const glm::quat* frame_rotations(int frame) const {
+    return rotations.data() + static_cast<size_t>(frame) * num_joints;
+  }
+  const glm::vec3* frame_translations(int frame) const {
+    return translations.data() + static_cast<size_t>(frame) * num_joints;
+  }
+};
+
+Status validate_clip(const Clip& clip, const Skeleton& skeleton);
+
+// A loaded or generated set: one skeleton, its clips, and optionally a skinned mesh.
+struct SkinnedMesh;
+struct ClipSet {
+  std::shared_ptr<const Skeleton> skeleton;
+  std::vector<Clip> clips;
+  std::shared_ptr<const SkinnedMesh> mesh;  // null when the source has none (BVH)
+  float scale_m_per_unit = 1.0f;            // the unit scale applied while loading
+  std::string scale_reason;                 // how it was chosen ("detected: centimetres", ...)
+  std::string source;
+};
+
+}  // namespace gk

@@ -1,0 +1,95 @@
+#pragma once
+// Runtime jobs over one character's pose (ozz-animation style): inputs as spans of const data,
+// outputs as spans the caller owns, validate() before run(), no allocation inside. The crowd-wide
+// passes call them per agent in parallel.
+
+#include <span>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "animation/clip.h"
+#include "animation/skeleton.h"
+
+namespace gk {
+
+// Samples a clip at time_s with linear interpolation of translations and normalised lerp of
+// rotations (shortest arc). Looping clips wrap time; others clamp it to [0, duration].
+struct SampleClipJob {
+  const Clip* clip = nullptr;
+  float time_s = 0.0f;
+  std::span<glm::quat> out_rotations;    // num_joints
+  std::span<glm::vec3> out_translations;  // num_joints
+  bool validate() const;
+  void run() const;
+};
+
+// One input of a blend: a local pose and its weight (weights need not sum to 1; they are
+// normalised; layers with weight <= 0 are skipped).
+struct PoseLayer {
+  std::span<const glm::quat> rotations;
+  std::span<const glm::vec3> translations;
+  float weight = 0.0f;
+};
+
+// Weighted blend of N local poses: translations by weighted mean, rotations by weighted nlerp with
+// every quaternion brought into the hemisphere of the first layer's.
+struct BlendPosesJob {
+  std::span<const PoseLayer> layers;
+  std::span<glm::quat> out_rotations;
+  std::span<glm::vec3> out_translations;
+  bool validate() const;
+  void run() const;
+};
+
+// Local to model (forward kinematics): out_model[i] = out_model[parent] * T(t_i) * R(q_i), with
+// root_transform applied to the roots (world placement of the character).
+struct LocalToModelJob {
+  const Skeleton* skeleton = nullptr;
+  std::span<const glm::quat> rotations;
+  std::span<const glm::vec3> translations;
+  glm::mat4 root_transform = glm::mat4(1.0f);
+  std::span<glm::mat4> out_model;
+  bool validate() const;
+  void run() const;
+};
+
+// Analytic two-bone IK (hip-knee-ankle). Given the model-space transforms of the start, mid and
+// end joints, finds local rotation corrections so that the end joint reaches target (or gets as
+// close as the limb allows), with the mid joint bending toward pole. Apply them as
+//   local[start] = local[start] * out_start_correction; local[mid] = local[mid] * out_mid_correction
+// and recompute FK below the start joint.
+struct TwoBoneIKJob {
+  glm::mat4 start_model{1.0f};
+  glm::mat4 mid_model{1.0f};
+  glm::mat4 end_model{1.0f};
+  glm::vec3 target{0.0f};
+  glm::vec3 pole{0.0f, 0.0f, 1.0f};  // model-space direction the knee should point to
+  float weight = 1.0f;               // [0, 1]: 0 leaves the pose unchanged
+  // Fraction of the full limb length never exceeded, so the knee never snaps straight.
+  float max_extension = 0.999f;
+  glm::quat* out_start_correction = nullptr;
+  glm::quat* out_mid_correction = nullptr;
+  bool* out_reached = nullptr;  // optional: target within reach
+  bool validate() const;
+  void run() const;
+};
+
+// Skinning matrices: out[j] = model[j] * inverse_bind[j].
+struct SkinningPaletteJob {
+  std::span<const glm::mat4> model;
+  std::span<const glm::mat4> inverse_bind;
+  std::span<glm::mat4> out_palette;
+  bool validate() const;
+  void run() const;
+};
+
+// Small helpers used by several jobs and by analysis.
+inline glm::vec3 translation_of(const glm::mat4& m) { return glm::vec3(m[3]); }
+// Heading [rad] about +y of a horizontal direction (0 = +z, pi/2 = +x).
+float heading_of(const glm::vec3& dir);
+// Forward (+z) direction of a model matrix, projected on the ground and normalised (0 if vertical).
+glm::vec3 horizontal_forward(const glm::mat4& m);
+
+}  // namespace gk

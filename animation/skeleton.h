@@ -1,0 +1,95 @@
+#pragma once
+// Skeleton: the joint hierarchy as plain arrays (structure of arrays), translations in metres,
+// rotations as unit quaternions. Built once by a loader or builder and then treated as immutable
+// (modules share it as std::shared_ptr<const Skeleton>).
+//
+// Conventions used everywhere in Gaitkeeper: y is up, the ground is y = 0, a character in its rest
+// pose faces +z and has its left side at +x. A heading angle theta [rad] about +y maps +z to
+// (sin theta, 0, cos theta).
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "common/status.h"
+
+namespace gk {
+
+// Semantic roles the mediator and analysis need, detected from joint names.
+enum class JointRole : uint8_t {
+  kHips,
+  kSpine,  // first spine joint above the hips
+  kChest,  // upper chest / neck base: the "upper body" of METRICS.md
+  kNeck,
+  kHead,
+  kLeftHip,
+  kLeftKnee,
+  kLeftAnkle,
+  kLeftToe,
+  kRightHip,
+  kRightKnee,
+  kRightAnkle,
+  kRightToe,
+  kLeftShoulder,
+  kRightShoulder,
+  kCount
+};
+inline constexpr int kNumJointRoles = static_cast<int>(JointRole::kCount);
+std::string_view joint_role_name(JointRole role);  // "hips", "left_knee", ...
+bool joint_role_from_name(std::string_view name, JointRole* out_role);
+
+enum class Side : uint8_t { kLeft = 0, kRight = 1 };
+
+struct Skeleton {
+  std::vector<std::string> names;
+  // parents[i] < i for every joint but the root(s), whose parent is -1 (topological order).
+  std::vector<int16_t> parents;
+  // Rest pose, local to the parent [m].
+  std::vector<glm::vec3> rest_translations;
+  std::vector<glm::quat> rest_rotations;
+  // Joint index per role, -1 if absent.
+  std::array<int16_t, kNumJointRoles> roles;
+  // Joints from the first spine joint above the hips up to and including the chest, bottom first:
+  // the joints the torso twist is spread over.
+  std::vector<int16_t> spine_chain;
+
+  Skeleton() { roles.fill(-1); }
+  int num_joints() const { return static_cast<int>(parents.size()); }
+  int role(JointRole r) const { return roles[static_cast<int>(r)]; }
+  bool has(JointRole r) const { return role(r) >= 0; }
+  int find(std::string_view name) const;  // -1 if absent
+  // Hip, knee, ankle, toe of one side.
+  int hip(Side s) const { return role(s == Side::kLeft ? JointRole::kLeftHip : JointRole::kRightHip); }
+  int knee(Side s) const {
+    return role(s == Side::kLeft ? JointRole::kLeftKnee : JointRole::kRightKnee);
+  }
+  int ankle(Side s) const {
+    return role(s == Side::kLeft ? JointRole::kLeftAnkle : JointRole::kRightAnkle);
+  }
+  int toe(Side s) const { return role(s == Side::kLeft ? JointRole::kLeftToe : JointRole::kRightToe); }
+  // True when every role the mediator needs for locomotion (hips, chest, both legs) is present.
+  bool has_locomotion_roles() const;
+};
+
+// Fills roles and spine_chain from the joint names, recognising CMU/cgspeed (LeftUpLeg/LeftLeg/
+// LeftFoot/LeftToeBase and LeftHip/LeftKnee/LeftAnkle/LeftToe), Rigify (DEF-thigh.L), Mixamo
+// (mixamorig:LeftUpLeg) and plain (l_hip, left_knee) names, with topology checks (a knee must be
+// below its hip, ...). Unrecognised roles stay -1.
+void detect_joint_roles(Skeleton* skeleton);
+
+// Overrides roles from a JSON manifest: {"roles": {"left_knee": "Knee_L", ...}}. Errors name the
+// manifest file and the field.
+Status apply_role_manifest(const std::string& manifest_path, Skeleton* skeleton);
+Status apply_role_manifest_text(std::string_view json_text, const std::string& source_name,
+                                Skeleton* skeleton);
+
+// Validates structure (sizes agree, parents topological, finite numbers, unit quaternions).
+Status validate_skeleton(const Skeleton& skeleton, const std::string& source_name);
+
+}  // namespace gk

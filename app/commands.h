@@ -1,0 +1,17 @@
+#pragma once
+// Each CLI mode registers itself as a CLI11 subcommand; main() only wires them.
+
+namespace CLI {
+class App;
+}
+
+namespace gk::app {
+
+void add_analyze_clip_command(CLI::App& app);
+
+// Thrown by a command to end the program with a message and exit code (no crash, no stack trace).
+struct ExitRequest {
+  int code = 1;
+};
+
+}  // namespace gk::app
