@@ -7,7 +7,8 @@ class App;
 
 namespace gk::app {
 
-void add_analyze_clip_command(CLI::App& app);
+void add_analyze_clip_command(CLI::App& app);  // app/cmd_analyze_clip.cc
+void add_bench_command(CLI::App& app);         // app/cmd_bench.cc
 
 // Thrown by a command to end the program with a message and exit code (no crash, no stack trace).
 struct ExitRequest {

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
       "An Animation Planning Mediator between a crowd simulator and skeletal animation."};
   app.require_subcommand(0, 1);
   gk::app::add_analyze_clip_command(app);
+  gk::app::add_bench_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
