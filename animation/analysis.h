@@ -19,7 +19,7 @@ struct ContactThresholds {
   float height_above_min_m = 0.025f;  // toe height above its lowest point (METRICS.md)
   float ankle_above_min_m = 0.05f;    // ankle height above its lowest point (METRICS.md)
   float max_speed_m_s = 0.6f;         // horizontal toe speed relative to the ground
-  int min_frames = 2;                 // shorter contacts/gaps are filtered out
+  float min_duration_s = 0.04f;       // shorter contacts and gaps are capture jitter: dropped
 };
 
 struct SlideStats {
@@ -43,6 +43,11 @@ struct ClipAnalysis {
   // Per frame: gait phase in [0, 1), 0 at the left foot's contact start (linear between contacts).
   std::vector<float> phase;
   SlideStats floor;              // foot-slide metrics of the clip played with its own root motion
+  // Ground under the feet, fitted to the lowest toe heights: y = ground_y0_m + ground_slope_m_s * t.
+  // Mocap floors are rarely level (the CMU walk rises 5 cm over 2.6 s); contacts are measured
+  // against this line rather than one global minimum.
+  float ground_y0_m = 0.0f;
+  float ground_slope_m_s = 0.0f;
 };
 
 ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& skeleton,

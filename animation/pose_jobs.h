@@ -15,7 +15,10 @@
 namespace gk {
 
 // Samples a clip at time_s with linear interpolation of translations and normalised lerp of
-// rotations (shortest arc). Looping clips wrap time; others clamp it to [0, duration].
+// rotations (shortest arc). Looping clips wrap time; others clamp it to [0, duration]. Between the
+// last frame of a loop and its first, the root joint (joint 0) keeps its mean horizontal velocity
+// instead of jumping back, so root motion stays continuous within one loop; callers that chain loops
+// add one loop's displacement per wrap.
 struct SampleClipJob {
   const Clip* clip = nullptr;
   float time_s = 0.0f;

@@ -1,0 +1,154 @@
+// `gaitkeeper analyze-clip FILE... [--scale S] [--json]`: loads BVH/glTF clips (or the built-in
+// set, FILE = "builtin") and prints each clip's analysis: speed, direction, cycle, foot contacts and
+// the foot-slide floor of METRICS.md.
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "animation/analysis.h"
+#include "animation/clip_library.h"
+#include "animation/procedural.h"
+#include "app/commands.h"
+
+namespace gk::app {
+namespace {
+
+struct AnalyzeOptions {
+  std::vector<std::string> files;
+  float scale = 0.0f;
+  bool json = false;
+};
+
+nlohmann::json intervals_json(const std::vector<TimeInterval>& v) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const TimeInterval& c : v) out.push_back({c.start_s, c.end_s});
+  return out;
+}
+
+nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAnalysis& a) {
+  return {
+      {"file", set.source},
+      {"name", clip.name},
+      {"frames", clip.num_frames},
+      {"fps", clip.fps},
+      {"duration_s", a.duration_s},
+      {"joints", clip.num_joints},
+      {"loops", clip.loops},
+      {"scale", set.scale_m_per_unit},
+      {"scale_reason", set.scale_reason},
+      {"in_place", a.in_place},
+      {"native_speed_m_s", a.native_speed_m_s},
+      {"direction_deg", a.direction_rad * 180.0f / std::numbers::pi_v<float>},
+      {"cycle", {{"start_s", a.cycle.start_s}, {"end_s", a.cycle.end_s}}},
+      {"contacts", {{"left", intervals_json(a.contacts[0])}, {"right", intervals_json(a.contacts[1])}}},
+      {"foot_slide_floor_cm_s", a.floor.mean_cm_s},
+      {"foot_slide_floor_p95_cm_s", a.floor.p95_cm_s},
+      {"skate_ratio_floor", a.floor.skate_ratio},
+      {"foot_drift_floor_cm_per_step", a.floor.drift_cm_per_step},
+  };
+}
+
+void print_text(const nlohmann::json& j) {
+  std::printf("%s  [%s]\n", j["name"].get<std::string>().c_str(), j["file"].get<std::string>().c_str());
+  std::printf("  frames %d @ %.3g fps, %.3f s, %d joints, scale %.6g m/unit (%s)%s\n",
+              j["frames"].get<int>(), j["fps"].get<double>(), j["duration_s"].get<double>(),
+              j["joints"].get<int>(), j["scale"].get<double>(),
+              j["scale_reason"].get<std::string>().c_str(), j["loops"].get<bool>() ? ", loops" : "");
+  std::printf("  speed %.3f m/s%s, direction %.1f deg, cycle %.3f-%.3f s\n",
+              j["native_speed_m_s"].get<double>(), j["in_place"].get<bool>() ? " (in place: from stance foot)" : "",
+              j["direction_deg"].get<double>(), j["cycle"]["start_s"].get<double>(),
+              j["cycle"]["end_s"].get<double>());
+  for (const char* side : {"left", "right"}) {
+    std::printf("  contacts %-5s:", side);
+    for (const auto& c : j["contacts"][side]) {
+      std::printf(" [%.3f, %.3f]", c[0].get<double>(), c[1].get<double>());
+    }
+    std::printf("\n");
+  }
+  std::printf("  foot-slide floor %.2f cm/s (p95 %.2f, skate ratio %.3f, drift %.2f cm/step)\n",
+              j["foot_slide_floor_cm_s"].get<double>(), j["foot_slide_floor_p95_cm_s"].get<double>(),
+              j["skate_ratio_floor"].get<double>(), j["foot_drift_floor_cm_per_step"].get<double>());
+}
+
+int run_analyze(const AnalyzeOptions& opt) {
+  std::vector<std::string> files;
+  bool builtin = false;
+  std::vector<std::string> paths;
+  for (const std::string& f : opt.files) {
+    if (f == "builtin") {
+      builtin = true;
+    } else {
+      paths.push_back(f);
+    }
+  }
+  if (!paths.empty()) {
+    Result<std::vector<std::string>> expanded = expand_clip_paths(paths);
+    if (!expanded.ok()) {
+      std::fprintf(stderr, "gaitkeeper analyze-clip: %s\n", expanded.message().c_str());
+      return 1;
+    }
+    files = *expanded;
+  }
+  std::vector<ClipSet> sets;
+  if (builtin) sets.push_back(make_builtin_clip_set());
+  LoadOptions load;
+  load.scale_m_per_unit = opt.scale;
+  int failures = 0;
+  for (const std::string& f : files) {
+    Result<ClipSet> set = load_clip_file(f, load);
+    if (!set.ok()) {
+      std::fprintf(stderr, "gaitkeeper analyze-clip: %s\n", set.message().c_str());
+      ++failures;
+      continue;
+    }
+    sets.push_back(std::move(*set));
+  }
+  nlohmann::json all = nlohmann::json::array();
+  for (const ClipSet& set : sets) {
+    if (!set.skeleton->has_locomotion_roles()) {
+      std::fprintf(stderr,
+                   "gaitkeeper analyze-clip: %s: skeleton lacks hips/leg joints the analysis needs "
+                   "(give a role manifest)\n",
+                   set.source.c_str());
+      ++failures;
+      continue;
+    }
+    for (const Clip& clip : set.clips) {
+      const ClipAnalysis a = analyze_clip(clip, *set.skeleton);
+      nlohmann::json j = analysis_json(set, clip, a);
+      if (!opt.json) print_text(j);
+      all.push_back(std::move(j));
+    }
+  }
+  if (opt.json) std::cout << all.dump(2) << "\n";
+  return failures > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+void add_analyze_clip_command(CLI::App& app) {
+  auto opt = std::make_shared<AnalyzeOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "analyze-clip",
+      "Analyse clips: native speed and direction, gait cycle, foot contacts, foot-slide floor.");
+  cmd->add_option("files", opt->files,
+                  "BVH, glTF or GLB files, folders of them, or 'builtin' for the built-in set")
+      ->required();
+  cmd->add_option("--scale", opt->scale,
+                  "metres per file unit (default: detected from the leg length)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--json", opt->json, "print a JSON array instead of text");
+  cmd->callback([opt] {
+    const int code = run_analyze(*opt);
+    if (code != 0) throw ExitRequest{code};
+  });
+}
+
+}  // namespace gk::app
