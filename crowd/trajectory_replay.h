@@ -3,6 +3,20 @@
 // tab or space separated). Positions are resampled smoothly (C1: no velocity jumps) to the
 // simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
 // is ignored: the data is the truth.
+//
+// Coordinates: the file's ground (x, y) [m] becomes our ground (x, z) = (x, y) unchanged, so
+// distances, speeds and ids match the data; seen from above (+y) the scene is the mirror image of a
+// plot of the file with y up (a reflection, harmless for walking).
+// Time: t = (frame - first frame of the file) / step * frame_time_s, where step is the file's usual
+// frame difference between consecutive samples of a pedestrian; time_s() starts at 0 there.
+// A pedestrian is live from its first sample to its last (missing frames within a track are
+// interpolated across); ids are the file's pedestrian ids; capacity() is the largest number of
+// pedestrians live at once. Positions follow a monotone cubic Hermite spline through the samples
+// (exact at the recorded times, no overshoot per axis), velocity is its derivative and theta is the
+// smoothed heading of the velocity, held while the speed is below 0.1 m/s.
+//
+// Errors (file and line): wrong column count, non-numbers, NaN/inf, frame not a whole number in
+// [0, 2^31), id not a whole number in [0, 2^32), duplicate (frame, id), no rows at all.
 
 #include <memory>
 #include <string>
@@ -14,6 +28,7 @@ namespace gk {
 struct ReplayOptions {
   // Seconds between two consecutive samples of one pedestrian, a sample step being the file's
   // usual difference between consecutive frame numbers (10 in the ETH/UCY files). [s] [> 0]
+  // Note: biwi_eth.txt is resampled from 6-frame annotations; its 10-id step spans ~0.667 s.
   float frame_time_s = 0.4f;
 };
 

@@ -1,0 +1,204 @@
+#include "crowd/trajectory_file.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <tuple>
+
+namespace gk {
+namespace {
+
+// Frame numbers are video frame indices; ids index nothing (they are only sorted), so any 32-bit
+// value is fine. Coordinates are metres on a ground plane: a bound keeps float maths exact enough.
+constexpr double kMaxFrame = 2147483647.0;
+constexpr double kMaxId = 4294967295.0;
+constexpr double kMaxCoordinate_m = 1.0e5;
+constexpr std::streamoff kMaxFileBytes = std::streamoff(1) << 30;
+
+struct Row {
+  uint32_t id;
+  int64_t frame;
+  glm::vec2 position;
+  int line;
+};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// Splits a line on spaces/tabs into at most `max_tokens` tokens; returns the total token count
+// (which may exceed max_tokens, to report it).
+int split_tokens(std::string_view line, std::string_view* out_tokens, int max_tokens) {
+  int count = 0;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && is_space(line[i])) ++i;
+    if (i >= line.size()) break;
+    const size_t start = i;
+    while (i < line.size() && !is_space(line[i])) ++i;
+    if (count < max_tokens) out_tokens[count] = line.substr(start, i - start);
+    ++count;
+  }
+  return count;
+}
+
+Status parse_number(std::string_view token, const char* column, const std::string& file, int line,
+                    double* out_value) {
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || end != token.data() + token.size()) {
+    return Status::AtLine(file, line,
+                          std::string(column) + ": expected a number, found '" +
+                              std::string(token.substr(0, 40)) + "'");
+  }
+  if (!std::isfinite(value)) {
+    return Status::AtLine(file, line,
+                          std::string(column) + ": expected a finite number, found '" +
+                              std::string(token.substr(0, 40)) + "'");
+  }
+  *out_value = value;
+  return Status::Ok();
+}
+
+Status parse_row(std::string_view text, const std::string& file, int line, Row* out_row) {
+  std::string_view tokens[4];
+  const int count = split_tokens(text, tokens, 4);
+  if (count != 4) {
+    return Status::AtLine(file, line,
+                          "expected 4 numbers (frame id x y), found " + std::to_string(count));
+  }
+  static constexpr const char* kColumns[4] = {"column 1 (frame)", "column 2 (id)", "column 3 (x)",
+                                              "column 4 (y)"};
+  double values[4];
+  for (int c = 0; c < 4; ++c) {
+    GK_RETURN_IF_ERROR(parse_number(tokens[c], kColumns[c], file, line, &values[c]));
+  }
+  if (values[0] < 0.0 || values[0] > kMaxFrame || values[0] != std::floor(values[0])) {
+    return Status::AtLine(
+        file, line,
+        "column 1 (frame): expected a whole number in [0, 2^31), found " + std::string(tokens[0]));
+  }
+  if (values[1] < 0.0 || values[1] > kMaxId || values[1] != std::floor(values[1])) {
+    return Status::AtLine(
+        file, line,
+        "column 2 (id): expected a whole number in [0, 2^32), found " + std::string(tokens[1]));
+  }
+  for (int c = 2; c < 4; ++c) {
+    if (std::abs(values[c]) > kMaxCoordinate_m) {
+      return Status::AtLine(file, line,
+                            std::string(kColumns[c]) + ": expected a coordinate within +-1e5 m, " +
+                                "found " + std::string(tokens[c]));
+    }
+  }
+  out_row->frame = static_cast<int64_t>(values[0]);
+  out_row->id = static_cast<uint32_t>(values[1]);
+  out_row->position = glm::vec2(static_cast<float>(values[2]), static_cast<float>(values[3]));
+  out_row->line = line;
+  return Status::Ok();
+}
+
+// The most common positive frame difference between consecutive samples of one pedestrian
+// (smallest on ties, so the result does not depend on the order of the rows).
+int64_t usual_frame_step(const std::vector<Row>& sorted_rows) {
+  std::vector<int64_t> diffs;
+  diffs.reserve(sorted_rows.size());
+  for (size_t i = 1; i < sorted_rows.size(); ++i) {
+    if (sorted_rows[i].id == sorted_rows[i - 1].id) {
+      diffs.push_back(sorted_rows[i].frame - sorted_rows[i - 1].frame);
+    }
+  }
+  if (diffs.empty()) return 1;
+  std::sort(diffs.begin(), diffs.end());
+  int64_t best = diffs[0];
+  size_t best_count = 0;
+  for (size_t i = 0; i < diffs.size();) {
+    size_t j = i;
+    while (j < diffs.size() && diffs[j] == diffs[i]) ++j;
+    if (j - i > best_count) {
+      best_count = j - i;
+      best = diffs[i];
+    }
+    i = j;
+  }
+  return best;
+}
+
+}  // namespace
+
+Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::string& file_name) {
+  std::vector<Row> rows;
+  // A row takes at least 8 bytes ("0 0 0 0\n"): reserve against the bytes actually present.
+  rows.reserve(text.size() / 8 + 1);
+  int line = 0;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view line_text = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line;
+    if (std::all_of(line_text.begin(), line_text.end(), is_space)) continue;  // blank line
+    Row row{};
+    GK_RETURN_IF_ERROR(parse_row(line_text, file_name, line, &row));
+    rows.push_back(row);
+  }
+  if (rows.empty()) {
+    return Status::AtLine(file_name, std::max(line, 1),
+                          "no trajectory rows: expected lines of 4 numbers (frame id x y)");
+  }
+
+  std::sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
+    return std::tie(a.id, a.frame, a.line) < std::tie(b.id, b.frame, b.line);
+  });
+  // Report the duplicate that comes first in the file, whatever the sort order.
+  int duplicate_line = std::numeric_limits<int>::max();
+  size_t duplicate_index = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    if (rows[i].id == rows[i - 1].id && rows[i].frame == rows[i - 1].frame &&
+        rows[i].line < duplicate_line) {
+      duplicate_line = rows[i].line;
+      duplicate_index = i;
+    }
+  }
+  if (duplicate_line != std::numeric_limits<int>::max()) {
+    const Row& dup = rows[duplicate_index];
+    return Status::AtLine(file_name, dup.line,
+                          "duplicate row for frame " + std::to_string(dup.frame) + ", pedestrian " +
+                              std::to_string(dup.id) + " (first at line " +
+                              std::to_string(rows[duplicate_index - 1].line) + ")");
+  }
+
+  TrajectoryTable table;
+  table.frame_step = usual_frame_step(rows);
+  table.first_frame = rows[0].frame;
+  table.frames.reserve(rows.size());
+  table.positions.reserve(rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (i == 0 || rows[i].id != rows[i - 1].id) {
+      table.ped_ids.push_back(rows[i].id);
+      table.track_begin.push_back(static_cast<uint32_t>(i));
+    }
+    table.frames.push_back(rows[i].frame);
+    table.positions.push_back(rows[i].position);
+    table.first_frame = std::min(table.first_frame, rows[i].frame);
+  }
+  table.track_begin.push_back(static_cast<uint32_t>(rows.size()));
+  return table;
+}
+
+Result<TrajectoryTable> read_trajectory_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return Status::AtLine(path, 0, "cannot open the file");
+  const std::streamoff size = in.tellg();
+  if (size < 0) return Status::AtLine(path, 0, "cannot read the file size");
+  if (size > kMaxFileBytes) {
+    return Status::AtLine(path, 0,
+                          "file too large (" + std::to_string(size) + " bytes, max 1 GiB)");
+  }
+  std::string text(static_cast<size_t>(size), '\0');
+  in.seekg(0);
+  if (size > 0 && !in.read(text.data(), size)) return Status::AtLine(path, 0, "read failed");
+  return parse_trajectory_text(text, path);
+}
+
+}  // namespace gk

@@ -1,0 +1,349 @@
+// Trajectory replay checked against the raw rows of the ETH/UCY files (parsed here, independently
+// of the loader) and against the median speeds stated in shared/data/PROVENANCE.md.
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+
+#include "crowd/trajectory_replay.h"
+#include "tests/test_data.h"
+
+namespace gk {
+namespace {
+
+constexpr int kFramesPerSample = 10;  // PROVENANCE.md: "step 10" in every file
+
+struct RawRow {
+  long frame;
+  long id;
+  double x, y;
+};
+
+std::vector<RawRow> read_raw(const std::string& path) {
+  std::vector<RawRow> rows;
+  std::ifstream in(path);
+  double f, id, x, y;
+  while (in >> f >> id >> x >> y) rows.push_back({std::lround(f), std::lround(id), x, y});
+  return rows;
+}
+
+// Per pedestrian: rows in frame order.
+std::map<long, std::vector<RawRow>> by_ped(const std::vector<RawRow>& rows) {
+  std::map<long, std::vector<RawRow>> peds;
+  for (const RawRow& r : rows) peds[r.id].push_back(r);
+  for (auto& [id, track] : peds) {
+    std::sort(track.begin(), track.end(),
+              [](const RawRow& a, const RawRow& b) { return a.frame < b.frame; });
+  }
+  return peds;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Median of the speeds between consecutive samples of each pedestrian, from the raw rows; only
+// steps faster than `min_speed_m_s` count.
+double raw_median_step_speed(const std::vector<RawRow>& rows, double frame_time_s,
+                             double min_speed_m_s = -1.0) {
+  std::vector<double> speeds;
+  for (const auto& [id, t] : by_ped(rows)) {
+    for (size_t i = 1; i < t.size(); ++i) {
+      const double dt = double(t[i].frame - t[i - 1].frame) / kFramesPerSample * frame_time_s;
+      const double speed = std::hypot(t[i].x - t[i - 1].x, t[i].y - t[i - 1].y) / dt;
+      if (speed > min_speed_m_s) speeds.push_back(speed);
+    }
+  }
+  return median(speeds);
+}
+
+std::unique_ptr<CrowdSource> load(const std::string& path, float frame_time_s) {
+  Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(path, {frame_time_s});
+  EXPECT_TRUE(r.ok()) << r.message();
+  return r.ok() ? std::move(*r) : nullptr;
+}
+
+// Median of the replay's speeds over every live agent of every 60 Hz frame (time-weighted, like
+// the per-step median of the raw data) and over the agents moving faster than 0.1 m/s.
+struct ReplaySpeeds {
+  double median_all = 0.0, median_moving = 0.0;
+};
+ReplaySpeeds replay_median_speeds(CrowdSource& replay, double duration_s) {
+  std::vector<double> all, moving;
+  constexpr float kDt = 1.0f / 60.0f;
+  while (replay.time_s() < duration_s) {
+    EXPECT_TRUE(replay.step(kDt).ok());
+    for (const glm::vec2& v : replay.frame().velocities) {
+      const double s = std::hypot(v.x, v.y);
+      all.push_back(s);
+      if (s > 0.1) moving.push_back(s);
+    }
+  }
+  return {median(all), median(moving)};
+}
+
+double duration_s(const std::vector<RawRow>& rows, double frame_time_s) {
+  long lo = rows[0].frame, hi = rows[0].frame;
+  for (const RawRow& r : rows) lo = std::min(lo, r.frame), hi = std::max(hi, r.frame);
+  return double(hi - lo) / kFramesPerSample * frame_time_s;
+}
+
+// Steps through the whole file at a quarter sample step; at every recorded frame compares each
+// raw row with the replayed agent of that id, and the live count with the pedestrians whose
+// recorded span contains the frame.
+void check_reproduces_rows(const std::string& rel, size_t expected_capacity) {
+  const std::vector<RawRow> rows = read_raw(test::data_path(rel));
+  ASSERT_FALSE(rows.empty());
+  const auto peds = by_ped(rows);
+  std::map<long, std::vector<RawRow>> at_frame;
+  for (const RawRow& r : rows) at_frame[r.frame].push_back(r);
+  const long first = at_frame.begin()->first, last = at_frame.rbegin()->first;
+
+  auto replay = load(test::data_path(rel), 0.4f);
+  ASSERT_TRUE(replay);
+  EXPECT_EQ(replay->capacity(), expected_capacity);
+  double max_error_m = 0.0;
+  size_t rows_checked = 0;
+  for (long frame = first; frame <= last; frame += kFramesPerSample) {
+    if (frame != first) {
+      for (int k = 0; k < 4; ++k) ASSERT_TRUE(replay->step(0.1f).ok());
+    }
+    const AgentFrame f = replay->frame();
+    size_t spanning = 0;
+    for (const auto& [id, t] : peds)
+      spanning += t.front().frame <= frame && frame <= t.back().frame;
+    EXPECT_EQ(f.size(), spanning) << "frame " << frame;
+    // These files have no missing frames inside a track, so that is also the frame's row count.
+    EXPECT_EQ(f.size(), at_frame[frame].size()) << "frame " << frame;
+    for (const RawRow& r : at_frame[frame]) {
+      const auto it = std::find(f.ids.begin(), f.ids.end(), static_cast<uint32_t>(r.id));
+      ASSERT_NE(it, f.ids.end()) << "ped " << r.id << " missing at frame " << frame;
+      const glm::vec2 p = f.positions[it - f.ids.begin()];
+      max_error_m = std::max(max_error_m, std::hypot(p.x - r.x, p.y - r.y));
+      ++rows_checked;
+    }
+  }
+  EXPECT_EQ(rows_checked, rows.size());
+  EXPECT_LT(max_error_m, 0.01);
+  std::cout << rel << ": max position error " << max_error_m << " m over " << rows_checked
+            << " rows\n";
+}
+
+TEST(TrajectoryReplay, ReproducesEveryRecordedRowZara1) {
+  GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
+  check_reproduces_rows("trajectories/zara1/crowds_zara01.txt", 20);  // PROVENANCE: max 20/frame
+}
+
+TEST(TrajectoryReplay, ReproducesEveryRecordedRowHotel) {
+  GK_REQUIRE_DATA("trajectories/hotel/biwi_hotel.txt");
+  check_reproduces_rows("trajectories/hotel/biwi_hotel.txt", 18);  // PROVENANCE: max 18/frame
+}
+
+// PROVENANCE.md: median step speeds at 0.4 s per 10 frame ids.
+TEST(TrajectoryReplay, MedianSpeedsMatchTheData) {
+  const struct {
+    const char* rel;
+    double provenance_m_s;
+  } kFiles[] = {{"trajectories/zara1/crowds_zara01.txt", 1.15},
+                {"trajectories/hotel/biwi_hotel.txt", 1.27},
+                {"trajectories/zara3/crowds_zara03.txt", 1.13}};
+  for (const auto& file : kFiles) {
+    GK_REQUIRE_DATA(file.rel);
+    const std::vector<RawRow> rows = read_raw(test::data_path(file.rel));
+    const double raw = raw_median_step_speed(rows, 0.4);
+    EXPECT_NEAR(raw, file.provenance_m_s, 0.006) << file.rel;  // the table rounds to 0.01
+    auto replay = load(test::data_path(file.rel), 0.4f);
+    ASSERT_TRUE(replay);
+    const ReplaySpeeds s = replay_median_speeds(*replay, duration_s(rows, 0.4));
+    EXPECT_NEAR(s.median_all, file.provenance_m_s, 0.1 * file.provenance_m_s) << file.rel;
+    // The table counts standing people too; over walkers only, compare with the raw walkers.
+    const double raw_moving = raw_median_step_speed(rows, 0.4, 0.1);
+    EXPECT_NEAR(s.median_moving, raw_moving, 0.1 * raw_moving) << file.rel;
+    std::cout << file.rel << ": raw median step speed " << raw
+              << " m/s (steps > 0.1 m/s: " << raw_moving << "), replay median " << s.median_all
+              << " (moving agents " << s.median_moving << ")\n";
+  }
+}
+
+// PROVENANCE.md's ETH caveat: 2.45 m/s at the usual 0.4 s per step, 1.47 m/s at the physically
+// right 0.667 s (the file is resampled from 6-frame annotations).
+TEST(TrajectoryReplay, EthTimingCaveat) {
+  const char* rel = "trajectories/eth/biwi_eth.txt";
+  GK_REQUIRE_DATA(rel);
+  const std::vector<RawRow> rows = read_raw(test::data_path(rel));
+  EXPECT_NEAR(raw_median_step_speed(rows, 0.4), 2.45, 0.01);
+  EXPECT_NEAR(raw_median_step_speed(rows, 0.667), 1.47, 0.01);
+  auto nominal = load(test::data_path(rel), 0.4f);
+  auto physical = load(test::data_path(rel), 0.667f);
+  ASSERT_TRUE(nominal && physical);
+  const double fast = replay_median_speeds(*nominal, duration_s(rows, 0.4)).median_all;
+  const double slow = replay_median_speeds(*physical, duration_s(rows, 0.667)).median_all;
+  EXPECT_NEAR(fast, 2.45, 0.245);
+  EXPECT_NEAR(slow, 1.47, 0.147);
+  // Same curves, time stretched: speeds scale exactly with 0.4 / 0.667 (up to frame sampling).
+  EXPECT_NEAR(slow / fast, 0.4 / 0.667, 0.01);
+  std::cout << rel << ": replay median " << fast << " m/s at 0.4 s, " << slow << " at 0.667 s\n";
+}
+
+// Largest change of one agent's velocity between consecutive frames, over the first `span_s`.
+double max_velocity_change(CrowdSource& replay, float dt_s, double span_s) {
+  std::map<uint32_t, glm::vec2> last;
+  double max_dv = 0.0;
+  while (replay.time_s() < span_s) {
+    EXPECT_TRUE(replay.step(dt_s).ok());
+    const AgentFrame f = replay.frame();
+    std::map<uint32_t, glm::vec2> now;
+    for (size_t i = 0; i < f.size(); ++i) {
+      now[f.ids[i]] = f.velocities[i];
+      if (auto it = last.find(f.ids[i]); it != last.end()) {
+        max_dv = std::max(max_dv, double(glm::length(f.velocities[i] - it->second)));
+      }
+    }
+    last.swap(now);
+  }
+  return max_dv;
+}
+
+// C1 continuity: a velocity jump at a sample would give the same frame-to-frame change at any
+// frame rate; a continuous velocity changes ten times less over a ten times shorter frame.
+TEST(TrajectoryReplay, VelocityIsContinuousAcrossSamples) {
+  const char* rel = "trajectories/zara1/crowds_zara01.txt";
+  GK_REQUIRE_DATA(rel);
+  const double span_s = 120.0;
+  auto at_60 = load(test::data_path(rel), 0.4f);
+  auto at_600 = load(test::data_path(rel), 0.4f);
+  ASSERT_TRUE(at_60 && at_600);
+  const double dv_60 = max_velocity_change(*at_60, 1.0f / 60.0f, span_s);
+  const double dv_600 = max_velocity_change(*at_600, 1.0f / 600.0f, span_s);
+  // Piecewise-linear interpolation would jump by the change between consecutive secants.
+  double max_secant_jump = 0.0;
+  for (const auto& [id, t] : by_ped(read_raw(test::data_path(rel)))) {
+    if (t.front().frame > span_s / 0.4 * kFramesPerSample) continue;
+    for (size_t i = 2; i < t.size(); ++i) {
+      const double ax = (t[i - 1].x - t[i - 2].x) / 0.4, ay = (t[i - 1].y - t[i - 2].y) / 0.4;
+      const double bx = (t[i].x - t[i - 1].x) / 0.4, by = (t[i].y - t[i - 1].y) / 0.4;
+      max_secant_jump = std::max(max_secant_jump, std::hypot(bx - ax, by - ay));
+    }
+  }
+  EXPECT_LT(dv_600, 0.2 * dv_60);
+  EXPECT_LT(dv_60, 0.5 * max_secant_jump);
+  std::cout << "max |dv| per frame: " << dv_60 << " m/s at 60 Hz, " << dv_600
+            << " at 600 Hz; raw secant jump " << max_secant_jump << "\n";
+}
+
+std::string write_scratch(const std::string& name, const std::string& text) {
+  const std::string path = test::scratch_dir("replay") + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// Each malformed file fails with "path:line: what".
+TEST(TrajectoryReplay, MalformedFilesNameFileAndLine) {
+  const struct {
+    const char* fixture;
+    int line;
+    const char* what;
+  } kCases[] = {
+      {"wrong_column_count.txt", 2, "expected 4 numbers (frame id x y), found 3"},
+      {"non_numeric.txt", 2, "column 3 (x): expected a number, found 'abc'"},
+      {"nan_value.txt", 4, "column 3 (x): expected a finite number"},
+      {"empty.txt", 1, "no trajectory rows"},
+      {"duplicate_row.txt", 4, "duplicate row for frame 10, pedestrian 1 (first at line 2)"},
+      {"huge_id.txt", 2, "column 2 (id): expected a whole number"},
+      {"comment_line.txt", 1, "expected 4 numbers"},
+      {"negative_frame.txt", 2, "column 1 (frame): expected a whole number"},
+  };
+  for (const auto& c : kCases) {
+    const std::string path = test::source_path("tests/data/bad/trajectories/") + c.fixture;
+    Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(path);
+    ASSERT_FALSE(r.ok()) << c.fixture;
+    const std::string prefix = path + ":" + std::to_string(c.line) + ": ";
+    EXPECT_EQ(r.message().rfind(prefix, 0), 0u) << r.message();
+    EXPECT_NE(r.message().find(c.what), std::string::npos) << r.message();
+  }
+  // Written here rather than as fixtures: whitespace-only lines and a fractional frame number.
+  const std::string blank = write_scratch("blank.txt", "\n  \t\n\r\n");
+  Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(blank);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.message().rfind(blank + ":3: no trajectory rows", 0), 0u) << r.message();
+  const std::string frac = write_scratch("frac.txt", "0 1 0 0\n5.5 1 1 1\n");
+  r = load_trajectory_replay(frac);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.message().rfind(frac + ":2: column 1 (frame)", 0), 0u) << r.message();
+  r = load_trajectory_replay(test::scratch_dir("replay") + "/does_not_exist.txt");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.message().find("does_not_exist.txt: cannot open"), std::string::npos);
+}
+
+TEST(TrajectoryReplay, RejectsBadFrameTimeAndSteps) {
+  const std::string path = write_scratch("ok.txt", "0 1 0 0\n10 1 1 0\n");
+  for (float bad : {0.0f, -0.4f, std::nanf(""), INFINITY}) {
+    Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(path, {bad});
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.message().rfind(path + ": frame_time_s: ", 0), 0u) << r.message();
+  }
+  auto replay = load(path, 0.4f);
+  ASSERT_TRUE(replay);
+  for (float bad : {0.0f, -1.0f, std::nanf("")}) EXPECT_FALSE(replay->step(bad).ok());
+  EXPECT_EQ(replay->time_s(), 0.0);
+}
+
+// Mixed separators, CRLF, blank lines, rows out of order, a track with missing frames (20, 30),
+// a pedestrian that stands still and one whose id needs all 32 bits.
+TEST(TrajectoryReplay, SyntheticTracksGapsAndHeadings) {
+  const std::string path = write_scratch("synthetic.txt",
+                                         "10\t1\t1.0\t0.0\r\n"
+                                         "0 1 0.0 0.0\n\n"
+                                         "40\t1  4.0\t0.0\n"
+                                         "50 1 5.0 0.0\n"
+                                         "0 4294967295 2.0 0.0\n"
+                                         "10 4294967295 2.0 1.0\n"
+                                         "20 4294967295 2.0 1.0\n"
+                                         "30 4294967295 2.0 1.0\n");
+  auto replay = load(path, 0.4f);
+  ASSERT_TRUE(replay);
+  EXPECT_EQ(replay->capacity(), 2u);
+  EXPECT_EQ(replay->feedback_policy(), FeedbackPolicy::kIgnored);
+  const auto find = [&](uint32_t id) -> int {
+    const AgentFrame f = replay->frame();
+    const auto it = std::find(f.ids.begin(), f.ids.end(), id);
+    return it == f.ids.end() ? -1 : int(it - f.ids.begin());
+  };
+  // Walking 1 m per 0.4 s along +x: inside the gap it keeps walking at 2.5 m/s, facing +x.
+  for (int k = 0; k < 3 * 4; ++k) ASSERT_TRUE(replay->step(0.1f).ok());  // t = 1.2 s: frame 30
+  int i = find(1);
+  ASSERT_GE(i, 0);
+  EXPECT_NEAR(replay->frame().positions[i].x, 3.0f, 1e-3f);
+  EXPECT_NEAR(replay->frame().velocities[i].x, 2.5f, 1e-3f);
+  EXPECT_NEAR(replay->frame().thetas[i], 1.5707963f, 1e-3f);  // pi/2 faces +x
+  // The other one walked +z (file y) and then stood still: it keeps facing +z.
+  i = find(4294967295u);
+  ASSERT_GE(i, 0);
+  EXPECT_NEAR(replay->frame().velocities[i].y, 0.0f, 1e-4f);
+  EXPECT_NEAR(replay->frame().thetas[i], 0.0f, 1e-3f);
+  // Feedback is ignored and changes nothing.
+  const uint8_t has[2] = {1, 1};
+  const glm::vec2 p[2] = {glm::vec2(9.0f), glm::vec2(9.0f)};
+  const float th[2] = {1.0f, 1.0f};
+  const glm::vec2 before = replay->frame().positions[0];
+  EXPECT_TRUE(replay->apply_feedback({has, p, p, th}).ok());
+  EXPECT_EQ(replay->frame().positions[0], before);
+  // After its last sample (frame 30 = 1.2 s) the stander vanishes; ped 1 goes on to 2.0 s.
+  ASSERT_TRUE(replay->step(0.1f).ok());
+  EXPECT_EQ(find(4294967295u), -1);
+  EXPECT_EQ(replay->frame().size(), 1u);
+  for (int k = 0; k < 8; ++k) ASSERT_TRUE(replay->step(0.1f).ok());
+  EXPECT_EQ(replay->frame().size(), 0u);
+}
+
+}  // namespace
+}  // namespace gk
