@@ -1,0 +1,418 @@
+#include "mediator/locomotion_library.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <numbers>
+
+#include "animation/pose_jobs.h"
+
+namespace gk {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kMinGaitSpeed = 0.25f;  // [m/s] slower "gaits" are treated as standing clips
+constexpr float kMaxGaitSpeed = 12.0f;  // [m/s] faster ones are not locomotion
+constexpr float kMetricRateHz = 60.0f;
+
+// Clips whose names say they are not walking/running are left out of the blend space.
+constexpr std::array<const char*, 22> kNonLocomotion = {
+    "crouch", "swim", "jump", "sit", "crawl", "climb", "death", "dead", "punch", "kick", "roll",
+    "fall",   "hit",  "pistol", "sword", "spell", "interact", "push", "pick", "dance", "tpose",
+    "t-pose"};
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool name_excluded(const std::string& name) {
+  const std::string n = lower(name);
+  for (const char* k : kNonLocomotion) {
+    if (n.find(k) != std::string::npos) return true;
+  }
+  return false;
+}
+
+float wrap_angle(float a) {
+  a = std::fmod(a + kPi, 2.0f * kPi);
+  if (a < 0.0f) a += 2.0f * kPi;
+  return a - kPi;
+}
+
+std::vector<glm::mat4> rest_model(const Skeleton& sk) {
+  std::vector<glm::mat4> m(sk.num_joints());
+  LocalToModelJob{&sk, sk.rest_rotations, sk.rest_translations, glm::mat4(1.0f), m}.run();
+  return m;
+}
+
+float leg_length(const Skeleton& sk, const std::vector<glm::mat4>& rest, Side s) {
+  const glm::vec3 h = translation_of(rest[sk.hip(s)]), k = translation_of(rest[sk.knee(s)]),
+                  a = translation_of(rest[sk.ankle(s)]);
+  return glm::length(k - h) + glm::length(a - k);
+}
+
+// Removes the clip's mean travel from the root and turns its facing to +z (about the origin), so
+// the pose keeps only the pelvis's own sway and bob.
+Clip make_in_place(const Clip& src, const Skeleton& sk, const ClipAnalysis& a, float facing_rad) {
+  Clip c = src;
+  const int n = c.num_frames, nj = c.num_joints;
+  const int hips = sk.role(JointRole::kHips);
+  std::vector<glm::mat4> model(nj);
+  std::vector<glm::vec3> hips_xz(n);
+  for (int f = 0; f < n; ++f) {
+    LocalToModelJob{&sk,
+                    {c.frame_rotations(f), static_cast<size_t>(nj)},
+                    {c.frame_translations(f), static_cast<size_t>(nj)},
+                    glm::mat4(1.0f),
+                    model}
+        .run();
+    hips_xz[f] = translation_of(model[hips]);
+    hips_xz[f].y = 0.0f;
+  }
+  // Travel: mean velocity of the hips (zero for in-place clips), centred on the mean position.
+  const glm::vec3 vel =
+      a.in_place || n < 2 ? glm::vec3(0.0f) : (hips_xz[n - 1] - hips_xz[0]) * (c.fps / (n - 1));
+  glm::vec3 centre(0.0f);
+  for (int f = 0; f < n; ++f) centre += hips_xz[f] - vel * (f / c.fps);
+  centre /= static_cast<float>(n);
+  const glm::quat yaw = glm::angleAxis(-facing_rad, glm::vec3(0, 1, 0));
+  for (int f = 0; f < n; ++f) {
+    glm::quat& r = c.rotations[static_cast<size_t>(f) * nj];
+    glm::vec3& t = c.translations[static_cast<size_t>(f) * nj];
+    r = yaw * r;
+    t = yaw * (t - centre - vel * (f / c.fps));
+    t.y -= a.ground_slope_m_s * (f / c.fps);  // level the capture floor
+  }
+  return c;
+}
+
+// Facing of the character in a clip: perpendicular to the right->left hip vector, averaged.
+float clip_facing(const Clip& c, const Skeleton& sk) {
+  std::vector<glm::mat4> model(sk.num_joints());
+  glm::vec3 sum(0.0f);
+  for (int f = 0; f < c.num_frames; ++f) {
+    LocalToModelJob{&sk,
+                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
+                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
+                    glm::mat4(1.0f),
+                    model}
+        .run();
+    const glm::vec3 lr = translation_of(model[sk.hip(Side::kLeft)]) -
+                         translation_of(model[sk.hip(Side::kRight)]);
+    sum += glm::cross(lr, glm::vec3(0, 1, 0));
+  }
+  return std::atan2(sum.x, sum.z);
+}
+
+// Fills the phase table from the analysis's per-frame phase over one cycle starting at start_s.
+bool build_phase_table(LocomotionClip* lc) {
+  const ClipAnalysis& a = lc->analysis;
+  const int n = a.num_frames;
+  if (n < 4 || a.phase.size() != static_cast<size_t>(n)) return false;
+  const float fps = a.fps;
+  int f0 = static_cast<int>(std::lround(lc->cycle_start_s * fps));
+  f0 = std::clamp(f0, 0, n - 1);
+  // Walk frames from the cycle start accumulating positive phase increments until one full cycle.
+  std::vector<float> ts{f0 / fps}, ps{0.0f};
+  float acc = 0.0f;
+  const float start_phase = a.phase[f0];
+  float prev = start_phase;
+  const bool loops = lc->clip.loops;
+  for (int k = 1; k <= 4 * n && acc < 1.0f; ++k) {
+    const int f = f0 + k;
+    if (!loops && f >= n) break;
+    const float ph = a.phase[f % n];
+    float d = ph - prev;
+    if (d < -0.5f) d += 1.0f;
+    if (d < 0.0f) d = 0.0f;  // phase never runs backward
+    prev = ph;
+    acc += d;
+    ts.push_back(f / fps);
+    ps.push_back(acc);
+  }
+  if (acc < 0.95f) return false;
+  // Phase of the first sample is start_phase, which need not be exactly 0: shift so table starts
+  // at phase 0 of the gait (the left contact).
+  for (int k = 0; k <= kPhaseTableSize; ++k) {
+    const float target = static_cast<float>(k) / kPhaseTableSize * acc / std::max(acc, 1.0f);
+    size_t i = 1;
+    while (i + 1 < ps.size() && ps[i] < target) ++i;
+    const float span = std::max(ps[i] - ps[i - 1], 1e-6f);
+    const float u = std::clamp((target - ps[i - 1]) / span, 0.0f, 1.0f);
+    lc->phase_to_time[k] = ts[i - 1] + u * (ts[i] - ts[i - 1]);
+  }
+  lc->cycle_s = lc->phase_to_time[kPhaseTableSize] - lc->phase_to_time[0];
+  return lc->cycle_s > 0.0f;
+}
+
+constexpr float kPlantToe = 0.035f;     // [m] METRICS.md contact (2.5 cm) with a margin: toe this low
+constexpr float kPlantAnkle = 0.06f;    // [m] and the ankle within this of its lowest (5 cm + margin)
+constexpr float kPlantSpeed = 1.5f;     // [m/s] a foot moving faster over the ground is swinging
+constexpr float kHoldToe = 0.035f;      // [m] a lock is kept until the toe rises past this
+constexpr float kHoldAnkle = 0.07f;     // [m] or the ankle past this (heel-off pivots on the ball)
+
+void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
+  const Clip& c = lc->clip;
+  const int n = c.num_frames;
+  std::vector<glm::mat4> model(sk.num_joints());
+  std::vector<glm::vec3> toe[2], ankle[2];
+  for (int f = 0; f < n; ++f) {
+    LocalToModelJob{&sk,
+                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
+                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
+                    glm::mat4(1.0f),
+                    model}
+        .run();
+    for (int s = 0; s < 2; ++s) {
+      toe[s].push_back(translation_of(model[sk.toe(static_cast<Side>(s))]));
+      ankle[s].push_back(translation_of(model[sk.ankle(static_cast<Side>(s))]));
+    }
+  }
+  // The in-place clip's feet move backward under the body at the travel velocity; add it back.
+  const glm::vec3 travel = lc->speed_m_s *
+                           glm::vec3(std::sin(lc->direction_rad), 0.0f, std::cos(lc->direction_rad));
+  for (int s = 0; s < 2; ++s) {
+    lc->plant[s].assign(n, 0);
+    lc->hold[s].assign(n, 0);
+    lc->toe_height_m[s].assign(n, 0.0f);
+    float min_t = 1e9f, min_a = 1e9f;
+    for (int f = 0; f < n; ++f) {
+      min_t = std::min(min_t, toe[s][f].y);
+      min_a = std::min(min_a, ankle[s][f].y);
+    }
+    lc->toe_floor_m[s] = min_t;
+    std::vector<uint8_t> analysed(n, 0);
+    for (const TimeInterval& iv : lc->analysis.contacts[s]) {
+      const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
+      const int b = static_cast<int>(std::lround(iv.end_s * c.fps));
+      for (int f = a; f <= b; ++f) analysed[((f % n) + n) % n] = 1;
+    }
+    for (int f = 0; f < n; ++f) {
+      const int g = f + 1 < n ? f + 1 : (c.loops ? 0 : f - 1);
+      glm::vec3 vel = (toe[s][g] - toe[s][f]) * (g > f ? c.fps : -c.fps) + travel;
+      if (g == 0) vel = travel;  // across a loop's wrap: no reliable difference
+      const float speed = std::hypot(vel.x, vel.z);
+      const float ht = toe[s][f].y - min_t, ha = ankle[s][f].y - min_a;
+      lc->toe_height_m[s][f] = ht;
+      lc->plant[s][f] = analysed[f] || (ht <= kPlantToe && ha <= kPlantAnkle && speed < kPlantSpeed);
+      lc->hold[s][f] = lc->plant[s][f] || (ht <= kHoldToe && ha <= kHoldAnkle);
+    }
+  }
+}
+
+float max_rotation_step(const Clip& c, int num_joints) {
+  const float dt = 1.0f / kMetricRateHz;
+  std::vector<glm::quat> r0(num_joints), r1(num_joints);
+  std::vector<glm::vec3> t(num_joints);
+  float best = 0.0f;
+  const float duration = c.duration_s();
+  const int steps = static_cast<int>(duration / dt);
+  SampleClipJob{&c, 0.0f, r0, t}.run();
+  for (int i = 1; i <= steps; ++i) {
+    SampleClipJob{&c, i * dt, r1, t}.run();
+    for (int j = 1; j < num_joints; ++j) {  // joint 0 carries the facing, not a local bend
+      const float d = std::abs(glm::dot(r0[j], r1[j]));
+      best = std::max(best, 2.0f * std::acos(std::min(1.0f, d)));
+    }
+    std::swap(r0, r1);
+  }
+  return best;
+}
+
+// A standing clip taken from the frame of a gait clip where both feet are planted closest
+// together, for libraries without an idle (e.g. a walk and a run).
+LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
+  const Clip& g = gait.clip;
+  std::vector<glm::mat4> model(sk.num_joints());
+  int best = 0;
+  float best_score = 1e9f;
+  for (int f = 0; f < g.num_frames; ++f) {
+    LocalToModelJob{&sk,
+                    {g.frame_rotations(f), static_cast<size_t>(g.num_joints)},
+                    {g.frame_translations(f), static_cast<size_t>(g.num_joints)},
+                    glm::mat4(1.0f),
+                    model}
+        .run();
+    glm::vec3 d = translation_of(model[sk.toe(Side::kLeft)]) -
+                  translation_of(model[sk.toe(Side::kRight)]);
+    const float planted = gait.toe_height_m[0][f] + gait.toe_height_m[1][f] +
+                          (gait.plant[0][f] && gait.plant[1][f] ? 0.0f : 1.0f);
+    const float score = std::hypot(d.x, d.z) + 4.0f * planted;
+    if (score < best_score) {
+      best_score = score;
+      best = f;
+    }
+  }
+  LocomotionClip idle;
+  idle.clip.name = "idle (from " + g.name + ")";
+  idle.clip.source = g.source;
+  idle.clip.fps = g.fps;
+  idle.clip.num_frames = 2;
+  idle.clip.num_joints = g.num_joints;
+  idle.clip.loops = true;
+  for (int k = 0; k < 2; ++k) {
+    idle.clip.rotations.insert(idle.clip.rotations.end(), g.frame_rotations(best),
+                               g.frame_rotations(best) + g.num_joints);
+    idle.clip.translations.insert(idle.clip.translations.end(), g.frame_translations(best),
+                                  g.frame_translations(best) + g.num_joints);
+  }
+  idle.cycle_s = idle.clip.duration_s();
+  for (int s = 0; s < 2; ++s) {
+    idle.plant[s].assign(2, 1);
+    idle.hold[s].assign(2, 1);
+    idle.toe_height_m[s].assign(2, 0.0f);
+  }
+  return idle;
+}
+
+}  // namespace
+
+float LocomotionClip::time_at_phase(float phase) const {
+  const float x = std::clamp(phase - std::floor(phase), 0.0f, 1.0f) * kPhaseTableSize;
+  const int i = std::min(static_cast<int>(x), kPhaseTableSize - 1);
+  const float u = x - i;
+  return phase_to_time[i] + u * (phase_to_time[i + 1] - phase_to_time[i]);
+}
+
+std::vector<std::string> LocomotionLibrary::clip_names() const {
+  std::vector<std::string> names;
+  for (const LocomotionClip& c : clips) names.push_back(c.clip.name);
+  return names;
+}
+
+Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, float root_scale) {
+  Clip out;
+  out.name = clip.name;
+  out.source = clip.source;
+  out.fps = clip.fps;
+  out.num_frames = clip.num_frames;
+  out.num_joints = dst.num_joints();
+  out.loops = clip.loops;
+  std::vector<int> map(dst.num_joints());
+  for (int j = 0; j < dst.num_joints(); ++j) map[j] = src.find(dst.names[j]);
+  out.rotations.resize(static_cast<size_t>(out.num_frames) * out.num_joints);
+  out.translations.resize(out.rotations.size());
+  for (int f = 0; f < clip.num_frames; ++f) {
+    for (int j = 0; j < dst.num_joints(); ++j) {
+      const size_t o = static_cast<size_t>(f) * out.num_joints + j;
+      const int s = map[j];
+      if (s < 0) {
+        out.rotations[o] = dst.rest_rotations[j];
+        out.translations[o] = dst.rest_translations[j];
+        continue;
+      }
+      out.rotations[o] = clip.frame_rotations(f)[s];
+      out.translations[o] =
+          dst.parents[j] < 0 ? clip.frame_translations(f)[s] * root_scale : dst.rest_translations[j];
+    }
+  }
+  return out;
+}
+
+Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& sets) {
+  if (sets.empty()) return Status::Error("clip library: no clip sets given");
+  LocomotionLibrary lib;
+  lib.skeleton = sets[0].skeleton;
+  lib.mesh = sets[0].mesh;
+  const Skeleton& sk = *lib.skeleton;
+  if (!sk.has_locomotion_roles()) {
+    return Status::Error(sets[0].source +
+                         ": skeleton lacks the hips/leg joints the mediator needs (hips, hip, knee, "
+                         "ankle and toe on both sides); give a role manifest");
+  }
+  const std::vector<glm::mat4> rest = rest_model(sk);
+  for (int s = 0; s < 2; ++s) lib.leg_length_m[s] = leg_length(sk, rest, static_cast<Side>(s));
+  const float dst_leg = 0.5f * (lib.leg_length_m[0] + lib.leg_length_m[1]);
+
+  std::vector<LocomotionClip> idles;
+  for (const ClipSet& set : sets) {
+    const Skeleton& src = *set.skeleton;
+    if (!src.has_locomotion_roles()) {
+      return Status::Error(set.source + ": skeleton lacks the hips/leg joints the mediator needs");
+    }
+    const std::vector<glm::mat4> src_rest = rest_model(src);
+    const float src_leg = 0.5f * (leg_length(src, src_rest, Side::kLeft) +
+                                  leg_length(src, src_rest, Side::kRight));
+    const bool same = set.skeleton == lib.skeleton;
+    for (const Clip& original : set.clips) {
+      if (name_excluded(original.name) || original.num_frames < 2) continue;
+      Clip clip = same ? original : retarget_clip(original, src, sk, dst_leg / src_leg);
+      LocomotionClip lc;
+      lc.analysis = analyze_clip(clip, sk);
+      const float facing = clip_facing(clip, sk);
+      lc.speed_m_s = lc.analysis.native_speed_m_s;
+      lc.direction_rad = lc.analysis.direction_rad;
+      lc.clip = make_in_place(clip, sk, lc.analysis, facing);
+      fill_contacts_and_heights(&lc, sk);
+      const bool both_feet = !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
+      if (lc.speed_m_s < kMinGaitSpeed) {
+        if (both_feet) {
+          lc.cycle_s = lc.clip.duration_s();
+          idles.push_back(std::move(lc));
+        }
+        continue;
+      }
+      if (lc.speed_m_s > kMaxGaitSpeed || !both_feet) continue;
+      lc.gait = true;
+      lc.cycle_start_s = lc.analysis.contacts[0][0].start_s;
+      if (!lc.clip.loops) lc.cycle_start_s = lc.analysis.cycle.start_s;
+      if (!build_phase_table(&lc)) continue;
+      lib.clips.push_back(std::move(lc));
+    }
+  }
+  if (lib.clips.empty()) {
+    return Status::Error("clip library: no walking or running clip found (a clip needs a travel speed "
+                         "of 0.25-12 m/s and foot contacts on both feet)");
+  }
+  // Direction groups: forward, left, right, backward, or their own direction.
+  for (int i = 0; i < static_cast<int>(lib.clips.size()); ++i) {
+    float d = lib.clips[i].direction_rad;
+    for (float snap : {0.0f, kPi / 2, -kPi / 2, kPi}) {
+      if (std::abs(wrap_angle(d - snap)) < glm::radians(30.0f)) d = snap == -kPi ? kPi : snap;
+    }
+    if (std::abs(wrap_angle(d - kPi)) < 1e-4f) d = kPi;
+    auto it = std::find_if(lib.groups.begin(), lib.groups.end(),
+                           [&](const DirectionGroup& g) { return std::abs(g.direction_rad - d) < 1e-4f; });
+    if (it == lib.groups.end()) {
+      lib.groups.push_back({d, {}});
+      it = lib.groups.end() - 1;
+    }
+    it->clips.push_back(i);
+    lib.max_speed_m_s = std::max(lib.max_speed_m_s, lib.clips[i].speed_m_s);
+  }
+  std::sort(lib.groups.begin(), lib.groups.end(),
+            [](const DirectionGroup& a, const DirectionGroup& b) { return a.direction_rad < b.direction_rad; });
+  for (size_t g = 0; g < lib.groups.size(); ++g) {
+    auto& v = lib.groups[g].clips;
+    std::sort(v.begin(), v.end(), [&](int a, int b) { return lib.clips[a].speed_m_s < lib.clips[b].speed_m_s; });
+    if (lib.groups[g].direction_rad == 0.0f) lib.forward_group = static_cast<int>(g);
+  }
+  if (lib.forward_group < 0) {
+    return Status::Error("clip library: no forward walking clip found (all clips travel sideways or "
+                         "backward)");
+  }
+  // Idle: the calmest standing clip, else a standing frame of the slowest forward clip.
+  if (!idles.empty()) {
+    auto calm = std::min_element(idles.begin(), idles.end(), [](const auto& a, const auto& b) {
+      return a.analysis.floor.mean_cm_s < b.analysis.floor.mean_cm_s;
+    });
+    lib.clips.push_back(std::move(*calm));
+  } else {
+    lib.clips.push_back(synthesise_idle(lib.clips[lib.groups[lib.forward_group].clips.front()], sk));
+  }
+  lib.idle = static_cast<int>(lib.clips.size()) - 1;
+  for (int s = 0; s < 2; ++s) {
+    lib.toe_floor_m[s] = 1e9f;
+    for (const LocomotionClip& c : lib.clips) {
+      if (c.gait) lib.toe_floor_m[s] = std::min(lib.toe_floor_m[s], c.toe_floor_m[s]);
+    }
+  }
+  for (const LocomotionClip& c : lib.clips) {
+    lib.max_rotation_step_rad = std::max(lib.max_rotation_step_rad, max_rotation_step(c.clip, sk.num_joints()));
+  }
+  return lib;
+}
+
+}  // namespace gk

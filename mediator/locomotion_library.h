@@ -1,0 +1,74 @@
+#pragma once
+// The mediator's view of a clip library, prepared once at load: every clip retargeted onto one
+// skeleton, analysed, made in-place (travel removed from the root, facing turned to +z), with a
+// phase->time table over one gait cycle, per-frame contact flags and toe heights, and grouped into
+// a (speed, direction) blend space. Works from two clips or twenty, of any proportions that share
+// joint names.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "animation/analysis.h"
+#include "animation/clip.h"
+#include "animation/mesh.h"
+
+namespace gk {
+
+inline constexpr int kPhaseTableSize = 64;
+
+struct LocomotionClip {
+  Clip clip;               // in place, facing +z, on the library skeleton
+  ClipAnalysis analysis;   // of the original (retargeted) clip
+  float speed_m_s = 0.0f;  // native ground speed
+  float direction_rad = 0.0f;  // travel direction relative to facing (0 forward, +pi/2 left)
+  bool gait = false;       // has a gait cycle (alternating contacts) and travels
+  float cycle_start_s = 0.0f;
+  float cycle_s = 1.0f;    // duration of one gait cycle (stride) in clip time
+  // Clip time [s] at phase k / kPhaseTableSize over one cycle (monotone, may exceed the duration of
+  // a looping clip; sampling wraps).
+  float phase_to_time[kPhaseTableSize + 1] = {};
+  // Per clip frame and foot (Side): `plant` where a foot lock may start (the foot is down by the
+  // METRICS.md contact test and nearly still on the ground, or the analysis says contact), `hold`
+  // where an existing lock is kept (the foot has not clearly lifted yet).
+  std::vector<uint8_t> plant[2];
+  std::vector<uint8_t> hold[2];
+  std::vector<float> toe_height_m[2];  // toe height above its lowest point
+  float toe_floor_m[2] = {0.0f, 0.0f};  // lowest toe height in the clip
+  float time_at_phase(float phase) const;  // phase in [0, 1)
+};
+
+// Clips of one travel direction, sorted by speed.
+struct DirectionGroup {
+  float direction_rad = 0.0f;
+  std::vector<int> clips;
+};
+
+struct LocomotionLibrary {
+  std::shared_ptr<const Skeleton> skeleton;
+  std::shared_ptr<const SkinnedMesh> mesh;
+  std::vector<LocomotionClip> clips;
+  int idle = -1;  // a standing clip (speed 0), possibly synthesised from a gait clip's frame
+  std::vector<DirectionGroup> groups;  // sorted by direction in (-pi, pi]
+  int forward_group = -1;
+  float max_speed_m_s = 0.0f;
+  float leg_length_m[2] = {0.0f, 0.0f};  // hip-knee + knee-ankle in the rest pose
+  // Height of each toe joint when the foot is flat on the ground [m] (lowest over the gait clips):
+  // planted feet are locked at this height.
+  float toe_floor_m[2] = {0.0f, 0.0f};
+  // Largest per-frame change of any joint's local rotation over all source clips, resampled to
+  // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
+  float max_rotation_step_rad = 0.0f;
+  std::vector<std::string> clip_names() const;
+  bool has_direction_clips() const { return groups.size() > 1; }
+};
+
+// Builds the library from one or more clip sets. The first set's skeleton is the library skeleton;
+// clips of other sets are retargeted to it by joint name (rotations copied, root translation scaled
+// by the ratio of leg lengths). Errors name the set and what is missing.
+Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& sets);
+
+// Retargets a clip by joint names onto `dst`; `root_scale` scales the root joint's translation.
+Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, float root_scale);
+
+}  // namespace gk

@@ -1,0 +1,403 @@
+#include "mediator/mediator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <tbb/parallel_for.h>
+
+#include "mediator/springs.h"
+
+namespace gk {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kAbsurdSpeed = 15.0f;  // [m/s] faster simulator velocities are treated as errors
+constexpr float kSwitchHysteresis = 0.26f;  // [rad] a new travel direction group must be this much better
+
+bool finite2(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+float heading2(const glm::vec2& v) { return std::atan2(v.x, v.y); }
+
+// Speed bracket within one direction group, with the standing clip at speed 0 below it.
+void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, float speed, float share,
+                       float* w) {
+  if (share <= 0.0f) return;
+  const std::vector<int>& c = g.clips;
+  const float first = lib.clips[c.front()].speed_m_s;
+  if (speed <= first) {
+    const float u = std::clamp(speed / first, 0.0f, 1.0f);
+    w[lib.idle] += share * (1.0f - u);
+    w[c.front()] += share * u;
+    return;
+  }
+  for (size_t k = 0; k + 1 < c.size(); ++k) {
+    const float a = lib.clips[c[k]].speed_m_s, b = lib.clips[c[k + 1]].speed_m_s;
+    if (speed <= b) {
+      const float u = (speed - a) / std::max(b - a, 1e-6f);
+      w[c[k]] += share * (1.0f - u);
+      w[c[k + 1]] += share * u;
+      return;
+    }
+  }
+  w[c.back()] += share;
+}
+
+}  // namespace
+
+Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& params, size_t capacity)
+    : library_(library), params_(params), capacity_(capacity), ids_(capacity) {
+  const size_t nc = library.clips.size();
+  const size_t L = capacity * kMaxBlendLayers;
+  slot_id_.assign(capacity, 0xffffffffu);
+  seen_.assign(capacity, 0);
+  to_erase_.reserve(capacity);
+  plans_.slot_of_agent.assign(capacity, -1);
+  plans_.agent_of_slot.assign(capacity, -1);
+  plans_.layer_clip.assign(L, 0);
+  plans_.layer_weight.assign(L, 0.0f);
+  plans_.layer_time_s.assign(L, 0.0f);
+  plans_.root_xz.assign(capacity, glm::vec2(0.0f));
+  plans_.lower_yaw.assign(capacity, 0.0f);
+  plans_.upper_yaw.assign(capacity, 0.0f);
+  plans_.travel_yaw.assign(capacity, 0.0f);
+  plans_.playback_rate.assign(capacity, 1.0f);
+  plans_.speed_m_s.assign(capacity, 0.0f);
+  for (int s = 0; s < 2; ++s) {
+    plans_.plant[s].assign(capacity, 1.0f);
+    plans_.hold[s].assign(capacity, 1.0f);
+  }
+  plans_.phase.assign(capacity, 0.0f);
+  plans_.blend_progress.assign(capacity, 1.0f);
+  plans_.standing.assign(capacity, 1);
+  plans_.fresh.assign(capacity, 1);
+  feedback_.has_feedback.assign(capacity, 0);
+  feedback_.positions.assign(capacity, glm::vec2(0.0f));
+  feedback_.velocities.assign(capacity, glm::vec2(0.0f));
+  feedback_.thetas.assign(capacity, 0.0f);
+  sim_vel_.assign(capacity, glm::vec2(0.0f));
+  vel_.assign(capacity, glm::vec2(0.0f));
+  vel_rate_.assign(capacity, glm::vec2(0.0f));
+  theta_.assign(capacity, 0.0f);
+  theta_rate_.assign(capacity, 0.0f);
+  lower_target_.assign(capacity, 0.0f);
+  clip_weights_.assign(capacity * nc, 0.0f);
+  scratch_target_.assign(capacity * nc, 0.0f);
+  phase_.assign(capacity, 0.0f);
+  idle_time_.assign(capacity, 0.0f);
+  cadence_scale_.assign(capacity, 1.0f);
+  fade_.assign(capacity, 1.0f);
+  dominant_.assign(capacity, static_cast<int16_t>(library.idle));
+}
+
+void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta) {
+  slot_id_[slot] = id;
+  const glm::vec2 vel = finite2(v) && glm::length(v) < kAbsurdSpeed ? v : glm::vec2(0.0f);
+  const float th = std::isfinite(theta) ? theta : heading2(vel);
+  vel_[slot] = vel;
+  vel_rate_[slot] = glm::vec2(0.0f);
+  theta_[slot] = th;
+  theta_rate_[slot] = 0.0f;
+  const float speed = glm::length(vel);
+  const float yaw = speed > params_.stop_speed_m_s ? heading2(vel) : th;
+  plans_.lower_yaw[slot] = yaw;
+  lower_target_[slot] = yaw;
+  plans_.root_xz[slot] = finite2(p) ? p : glm::vec2(0.0f);
+  plans_.fresh[slot] = 1;
+  // Variety: a random start phase and cadence, from the seed and the id (order-independent).
+  std::mt19937_64 rng(params_.seed * 0x9E3779B97F4A7C15ull + id);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  phase_[slot] = u01(rng);
+  idle_time_[slot] = 10.0f * u01(rng);
+  cadence_scale_[slot] = 1.0f + params_.stride_variation * (2.0f * u01(rng) - 1.0f);
+  // Start settled in the clips the current speed asks for (no fade-in from nothing).
+  const size_t nc = library_.clips.size();
+  float* w = &clip_weights_[slot * nc];
+  std::fill(w, w + nc, 0.0f);
+  choose_weights(slot, speed, 0.0f, w);
+  fade_[slot] = 1.0f;
+}
+
+void Mediator::choose_weights(int slot, float speed, float rel_dir, float* w) const {
+  const LocomotionLibrary& lib = library_;
+  const size_t nc = lib.clips.size();
+  std::fill(w, w + nc, 0.0f);
+  if (speed < params_.stop_speed_m_s) {
+    w[lib.idle] = 1.0f;
+    return;
+  }
+  if (params_.mode != MediatorMode::kApm) {
+    // Nearest-speed forward clip (or standing), no blending.
+    const DirectionGroup& g = lib.groups[lib.forward_group];
+    int best = lib.idle;
+    float best_d = speed;
+    for (int c : g.clips) {
+      const float d = std::abs(lib.clips[c].speed_m_s - speed);
+      if (d < best_d) {
+        best_d = d;
+        best = c;
+      }
+    }
+    w[best] = 1.0f;
+    return;
+  }
+  (void)slot;
+  const std::vector<DirectionGroup>& groups = lib.groups;
+  if (groups.size() == 1) {
+    add_group_weights(lib, groups[0], speed, 1.0f, w);
+    return;
+  }
+  // The two groups whose directions bracket rel_dir (circularly), interpolated by angle.
+  const int n = static_cast<int>(groups.size());
+  int lo = n - 1;
+  for (int g = 0; g < n; ++g) {
+    if (groups[g].direction_rad <= rel_dir) lo = g;
+  }
+  if (rel_dir < groups[0].direction_rad) lo = n - 1;
+  const int hi = (lo + 1) % n;
+  const float a = groups[lo].direction_rad;
+  float span = wrap_pi(groups[hi].direction_rad - a);
+  if (span <= 0.0f) span += 2.0f * kPi;
+  float off = wrap_pi(rel_dir - a);
+  if (off < 0.0f) off += 2.0f * kPi;
+  const float u = std::clamp(off / span, 0.0f, 1.0f);
+  add_group_weights(lib, groups[lo], speed, 1.0f - u, w);
+  add_group_weights(lib, groups[hi], speed, u, w);
+}
+
+Status Mediator::plan(const AgentFrame& frame, float dt_s) {
+  if (!(dt_s > 0.0f) || !std::isfinite(dt_s) || dt_s > 1.0f) {
+    return Status::Error("mediator: frame time must be in (0, 1] s, got " + std::to_string(dt_s));
+  }
+  const size_t n = frame.size();
+  if (n > capacity_) {
+    return Status::Error("mediator: " + std::to_string(n) + " agents exceed the capacity of " +
+                         std::to_string(capacity_));
+  }
+  num_agents_ = n;
+  std::fill(seen_.begin(), seen_.end(), 0);
+  std::fill(plans_.fresh.begin(), plans_.fresh.end(), 0);
+  // Known agents first, then free the slots of those that vanished, then take slots for new ones,
+  // so a crowd at capacity can swap agents within one frame.
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t id = frame.ids[i];
+    if (id == 0xffffffffu) return Status::Error("mediator: agent id 4294967295 is reserved");
+    const int32_t slot = ids_.find(id);
+    plans_.slot_of_agent[i] = slot;
+    if (slot < 0) continue;
+    if (seen_[slot]) return Status::Error("mediator: agent id " + std::to_string(id) + " appears twice");
+    seen_[slot] = 1;
+  }
+  std::fill(plans_.agent_of_slot.begin(), plans_.agent_of_slot.end(), -1);
+  for (size_t s = 0; s < capacity_; ++s) {
+    if (!seen_[s] && slot_id_[s] != 0xffffffffu) {
+      ids_.erase(slot_id_[s]);
+      slot_id_[s] = 0xffffffffu;
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (plans_.slot_of_agent[i] >= 0) continue;
+    bool created = false;
+    const int32_t slot = ids_.insert(frame.ids[i], &created);
+    if (slot < 0 || !created) {
+      return Status::Error("mediator: agent id " + std::to_string(frame.ids[i]) +
+                           (slot < 0 ? " does not fit the capacity" : " appears twice"));
+    }
+    seen_[slot] = 1;
+    init_slot(slot, frame.ids[i], frame.positions[i], frame.velocities[i], frame.thetas[i]);
+    plans_.slot_of_agent[i] = slot;
+  }
+  for (size_t i = 0; i < n; ++i) plans_.agent_of_slot[plans_.slot_of_agent[i]] = static_cast<int32_t>(i);
+
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      plan_agent(static_cast<int>(i), plans_.slot_of_agent[i], frame.positions[i],
+                 frame.velocities[i], frame.thetas[i], dt_s);
+    }
+  });
+  for (size_t i = 0; i < n; ++i) {
+    const glm::vec2 v = frame.velocities[i];
+    if (!finite2(v) || glm::length(v) > kAbsurdSpeed || !finite2(frame.positions[i]) ||
+        !std::isfinite(frame.thetas[i])) {
+      ++num_sanitised_;
+    }
+  }
+  return Status::Ok();
+}
+
+void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm::vec2& v_in,
+                          float theta_in, float dt) {
+  const LocomotionLibrary& lib = library_;
+  const MediatorParams& P = params_;
+  const size_t nc = lib.clips.size();
+  AnimationPlans& pl = plans_;
+
+  // Sanitise what the simulator gave (NaN, absurd speeds): hold the last good values.
+  const glm::vec2 p = finite2(p_in) ? p_in : pl.root_xz[slot];
+  glm::vec2 v = finite2(v_in) ? v_in : vel_[slot];
+  if (glm::length(v) > kAbsurdSpeed) v = vel_[slot];
+  const float theta_raw = std::isfinite(theta_in) ? theta_in : theta_[slot];
+  sim_vel_[agent] = v;
+
+  const bool apm = P.mode == MediatorMode::kApm;
+  // 1. Filtering (APM only: the naive and rate modes take the simulator as it is).
+  if (apm) {
+    critical_spring(vel_[slot], vel_rate_[slot], v, P.velocity_halflife_s, dt);
+    const float goal = theta_[slot] + wrap_pi(theta_raw - theta_[slot]);
+    critical_spring(theta_[slot], theta_rate_[slot], goal, P.theta_halflife_s, dt);
+  } else {
+    vel_[slot] = v;
+    theta_[slot] = theta_raw;
+  }
+  const glm::vec2 vel = vel_[slot];
+  const float speed = glm::length(vel);
+  const float theta = wrap_pi(theta_[slot]);
+  const bool standing = speed < P.stop_speed_m_s;
+  const float travel = standing ? pl.lower_yaw[slot] : heading2(vel);
+
+  // 2./3. Lower body follows v (or a strafe/backward orientation), upper body faces theta.
+  float psi = pl.lower_yaw[slot];
+  if (!apm) {
+    psi = standing ? psi : travel;
+  } else {
+    float target = travel;
+    if (standing) {
+      target = theta;
+    } else if (lib.has_direction_clips()) {
+      // Pick the travel-direction group that leaves the upper body the least twist.
+      const float current_d = wrap_pi(travel - lower_target_[slot]);
+      float best_cost = 1e9f, best_d = 0.0f;
+      for (const DirectionGroup& g : lib.groups) {
+        float cost = std::abs(wrap_pi(theta - (travel - g.direction_rad)));
+        if (std::abs(wrap_pi(g.direction_rad - current_d)) < 0.2f) cost -= kSwitchHysteresis;
+        if (cost < best_cost) {
+          best_cost = cost;
+          best_d = g.direction_rad;
+        }
+      }
+      target = travel - best_d;
+    }
+    lower_target_[slot] = target;
+    const float rate = glm::radians(P.lower_turn_rate_deg_s) * (standing ? 0.5f : 1.0f);
+    psi = wrap_pi(approach_angle(psi, target, rate * dt));
+  }
+  const float rel_dir = standing || !apm ? 0.0f : wrap_pi(travel - psi);
+
+  // 4./6. Target blend weights, faded toward over the blend time (APM) or switched at once.
+  float* w = &clip_weights_[slot * nc];
+  float* target_w = &scratch_target_[slot * nc];
+  choose_weights(slot, speed, rel_dir, target_w);
+  if (apm && !pl.fresh[slot]) {
+    const float step = dt / P.blend_time_s;
+    float diff = 0.0f;
+    for (size_t c = 0; c < nc; ++c) {
+      const float d = target_w[c] - w[c];
+      w[c] += std::clamp(d, -step, step);
+      diff += std::abs(target_w[c] - w[c]);
+    }
+    fade_[slot] = 1.0f - 0.5f * diff;
+  } else {
+    std::copy(target_w, target_w + nc, w);
+    fade_[slot] = 1.0f;
+  }
+  // Keep the kMaxBlendLayers heaviest clips.
+  int16_t* lc = &pl.layer_clip[slot * kMaxBlendLayers];
+  float* lw = &pl.layer_weight[slot * kMaxBlendLayers];
+  float* lt = &pl.layer_time_s[slot * kMaxBlendLayers];
+  std::fill(lw, lw + kMaxBlendLayers, 0.0f);
+  for (size_t c = 0; c < nc; ++c) {
+    if (w[c] <= 1e-4f) continue;
+    int k_min = 0;
+    for (int k = 1; k < kMaxBlendLayers; ++k) {
+      if (lw[k] < lw[k_min]) k_min = k;
+    }
+    if (w[c] > lw[k_min]) {
+      lw[k_min] = w[c];
+      lc[k_min] = static_cast<int16_t>(c);
+    }
+  }
+  float total = 0.0f;
+  for (int k = 0; k < kMaxBlendLayers; ++k) total += lw[k];
+  if (total <= 0.0f) {
+    lw[0] = 1.0f;
+    lc[0] = static_cast<int16_t>(lib.idle);
+    total = 1.0f;
+  }
+  // 5. Playback rate from speed, within limits; the rest is stride warping (foot IK), beyond that
+  // the deliverable speed goes back to the simulator.
+  float native = 0.0f, freq = 0.0f, gait_w = 0.0f;
+  glm::vec2 dir_sum(0.0f);
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    lw[k] /= total;
+    const LocomotionClip& clip = lib.clips[lc[k]];
+    native += lw[k] * clip.speed_m_s;
+    if (clip.gait && lw[k] > 0.0f) {
+      freq += lw[k] / clip.cycle_s;
+      gait_w += lw[k];
+      dir_sum += lw[k] * glm::vec2(std::sin(clip.direction_rad), std::cos(clip.direction_rad));
+    }
+  }
+  float rate = 1.0f;
+  if (gait_w > 0.0f) {
+    freq /= gait_w;
+    if (P.mode == MediatorMode::kNaive) {
+      rate = 1.0f;
+    } else if (native > 1e-3f) {
+      rate = std::clamp(speed / native * cadence_scale_[slot], P.min_playback_rate, P.max_playback_rate);
+    }
+    phase_[slot] = std::fmod(phase_[slot] + freq * rate * dt, 1.0f);
+  }
+  idle_time_[slot] += dt;
+  // Clip times at the shared gait phase (phase-synchronised blending; a new clip starts in phase).
+  float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f};
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const LocomotionClip& clip = lib.clips[lc[k]];
+    lt[k] = clip.gait ? clip.time_at_phase(phase_[slot])
+                      : std::fmod(idle_time_[slot], std::max(clip.clip.duration_s(), 1e-3f));
+    if (lw[k] <= 0.0f) continue;
+    const int nf = clip.clip.num_frames;
+    int f = static_cast<int>(std::lround(lt[k] * clip.clip.fps));
+    f = clip.clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
+    for (int s = 0; s < 2; ++s) {
+      plant[s] += lw[k] * clip.plant[s][f];
+      hold[s] += lw[k] * clip.hold[s][f];
+    }
+  }
+  // 8. Feedback: the speed and torso orientation the animation can deliver.
+  const int a = agent;
+  feedback_.has_feedback[a] = 0;
+  feedback_.positions[a] = p;
+  feedback_.velocities[a] = v;
+  feedback_.thetas[a] = theta_raw;
+  if (apm && P.feedback) {
+    const DirectionGroup& fg = lib.groups[lib.forward_group];
+    const float max_speed = lib.clips[fg.clips.back()].speed_m_s * P.max_playback_rate * (1.0f + P.max_stride_warp);
+    const float v_len = glm::length(v);
+    if (v_len > max_speed) {
+      feedback_.velocities[a] = v * (max_speed / v_len);
+      feedback_.has_feedback[a] = 1;
+    }
+    const float twist = wrap_pi(theta_raw - psi);
+    const float limit = glm::radians(P.torsion_limit_deg);
+    if (std::abs(twist) > limit && !lib.has_direction_clips()) {
+      feedback_.thetas[a] = wrap_pi(psi + std::clamp(twist, -limit, limit));
+      feedback_.has_feedback[a] = 1;
+    }
+  }
+
+  pl.root_xz[slot] = p;
+  pl.lower_yaw[slot] = psi;
+  pl.upper_yaw[slot] = apm ? theta : psi;
+  pl.travel_yaw[slot] = wrap_pi(psi + (gait_w > 0.0f ? std::atan2(dir_sum.x, dir_sum.y) : 0.0f));
+  pl.playback_rate[slot] = gait_w > 0.0f ? rate : 1.0f;
+  pl.speed_m_s[slot] = speed;
+  for (int s = 0; s < 2; ++s) {
+    pl.plant[s][slot] = plant[s];
+    pl.hold[s][slot] = hold[s];
+  }
+  pl.phase[slot] = phase_[slot];
+  pl.blend_progress[slot] = fade_[slot];
+  pl.standing[slot] = standing;
+}
+
+}  // namespace gk

@@ -1,0 +1,109 @@
+#pragma once
+// The Animation Planning Mediator: between any CrowdSource and the pose output it decides, per agent
+// and frame, which clips to play at what rate and blend, how the body is oriented, and what the
+// simulator must be told so the two stay consistent (ARCHITECTURE.md, steps 1-6 and 8; step 7,
+// foot locking, runs in the pose synthesis pass where the animated feet are known).
+//
+// All per-agent data lives in slots (structure of arrays) sized for the crowd's capacity at
+// construction; plan() allocates nothing and runs over agents in parallel.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "crowd/crowd_source.h"
+#include "mediator/id_map.h"
+#include "mediator/locomotion_library.h"
+#include "mediator/params.h"
+
+namespace gk {
+
+inline constexpr int kMaxBlendLayers = 4;
+
+// Per-slot plan for one frame, read by the pose synthesis pass and the metrics.
+struct AnimationPlans {
+  // Frame agent index -> slot, and slot -> frame agent index (-1 when the slot is free).
+  std::vector<int32_t> slot_of_agent;
+  std::vector<int32_t> agent_of_slot;
+  // Blend layers: clip index and weight (weights sum to 1; unused layers have weight 0).
+  std::vector<int16_t> layer_clip;    // [slot * kMaxBlendLayers + k]
+  std::vector<float> layer_weight;    // [slot * kMaxBlendLayers + k]
+  std::vector<float> layer_time_s;    // clip time to sample
+  std::vector<glm::vec2> root_xz;     // rendered root placement on the ground [m]
+  std::vector<float> lower_yaw;       // lower-body facing psi [rad]
+  std::vector<float> upper_yaw;       // desired upper-body facing (filtered theta) [rad]
+  std::vector<float> travel_yaw;      // travel direction implied by the played clips [rad]
+  std::vector<float> playback_rate;   // clip-time step / real time step
+  std::vector<float> speed_m_s;       // filtered speed
+  std::vector<float> plant[2];        // blended "a foot lock may start" of each foot, 0..1
+  std::vector<float> hold[2];         // blended "keep the lock" of each foot, 0..1
+  std::vector<float> phase;           // gait phase [0, 1)
+  std::vector<float> blend_progress;  // b: 0 when the chosen clips just changed, 1 when settled
+  std::vector<uint8_t> standing;      // 1 when below the stop speed
+  std::vector<uint8_t> fresh;         // 1 on the agent's first frame
+};
+
+// Feedback for the simulator, index-aligned with the last AgentFrame.
+struct FeedbackBuffers {
+  std::vector<uint8_t> has_feedback;
+  std::vector<glm::vec2> positions;
+  std::vector<glm::vec2> velocities;
+  std::vector<float> thetas;
+  AgentFeedback view(size_t n) const {
+    return {{has_feedback.data(), n}, {positions.data(), n}, {velocities.data(), n}, {thetas.data(), n}};
+  }
+};
+
+class Mediator {
+ public:
+  Mediator(const LocomotionLibrary& library, const MediatorParams& params, size_t capacity);
+
+  // Plans every live agent of the frame for a step of dt_s [s]. Bad simulator values (NaN, absurd
+  // speeds) are sanitised per agent and counted, never propagated.
+  Status plan(const AgentFrame& frame, float dt_s);
+
+  const AnimationPlans& plans() const { return plans_; }
+  const FeedbackBuffers& feedback() const { return feedback_; }
+  size_t num_agents() const { return num_agents_; }
+  size_t capacity() const { return capacity_; }
+  const LocomotionLibrary& library() const { return library_; }
+  const MediatorParams& params() const { return params_; }
+  void set_params(const MediatorParams& p) { params_ = p; }
+  // Agents whose input had to be sanitised (NaN or speeds above 15 m/s) since construction.
+  uint64_t num_sanitised() const { return num_sanitised_; }
+  // Sim-side velocity of agent i of the last frame (for the feedback metric).
+  std::span<const glm::vec2> sim_velocities() const { return {sim_vel_.data(), num_agents_}; }
+
+ private:
+  void init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta);
+  void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta, float dt);
+  void choose_weights(int slot, float speed, float rel_dir, float* out_w) const;
+
+  const LocomotionLibrary& library_;
+  MediatorParams params_;
+  size_t capacity_;
+  size_t num_agents_ = 0;
+  uint64_t num_sanitised_ = 0;
+  IdSlotMap ids_;
+  std::vector<uint32_t> slot_id_;
+  std::vector<uint8_t> seen_;
+  std::vector<int32_t> to_erase_;
+  AnimationPlans plans_;
+  FeedbackBuffers feedback_;
+  std::vector<glm::vec2> sim_vel_;
+  // Per-slot state.
+  std::vector<glm::vec2> vel_, vel_rate_;  // velocity spring
+  std::vector<float> theta_, theta_rate_;  // theta spring (unwrapped)
+  std::vector<float> lower_target_;        // discrete target facing of the lower body
+  std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
+  std::vector<float> phase_;               // gait phase
+  std::vector<float> idle_time_;           // clock of the standing clip
+  std::vector<float> cadence_scale_;       // per-agent variety
+  std::vector<float> fade_;                // blend progress
+  std::vector<int16_t> dominant_;          // clip with the largest target weight
+  std::vector<float> scratch_target_;      // [slot * num_clips]
+};
+
+}  // namespace gk

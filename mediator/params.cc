@@ -1,0 +1,196 @@
+#include "mediator/params.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace gk {
+namespace {
+
+using K = ParamInfo::Kind;
+using P = MediatorParams;
+
+constexpr ParamInfo kInfos[] = {
+    {"velocity_halflife_s", "s", "smoothing of the simulator's velocity (removes zig-zag)", 0.01f, 1.0f,
+     K::kFloat, &P::velocity_halflife_s},
+    {"theta_halflife_s", "s", "smoothing of the desired torso orientation", 0.01f, 1.0f, K::kFloat,
+     &P::theta_halflife_s},
+    {"torsion_limit_deg", "deg", "hard limit on the twist between pelvis and upper chest", 0.0f, 90.0f,
+     K::kFloat, &P::torsion_limit_deg},
+    {"lower_turn_rate_deg_s", "deg/s", "fastest turn of the lower body toward the walking direction",
+     30.0f, 1440.0f, K::kFloat, &P::lower_turn_rate_deg_s},
+    {"blend_time_s", "s", "cross-fade time when the chosen clips change", 0.05f, 1.0f, K::kFloat,
+     &P::blend_time_s},
+    {"min_playback_rate", "x", "slowest clip playback relative to real time", 0.1f, 1.0f, K::kFloat,
+     &P::min_playback_rate},
+    {"max_playback_rate", "x", "fastest clip playback relative to real time", 1.0f, 3.0f, K::kFloat,
+     &P::max_playback_rate},
+    {"max_stride_warp", "x", "stride length change absorbed by leg IK beyond the rate limits", 0.0f,
+     0.5f, K::kFloat, &P::max_stride_warp},
+    {"stop_speed_m_s", "m/s", "below this speed the agent stands (idle)", 0.0f, 0.5f, K::kFloat,
+     &P::stop_speed_m_s},
+    {"foot_locking", "on/off", "pin planted feet in world space with two-bone IK", 0.0f, 1.0f, K::kBool,
+     nullptr, &P::foot_locking},
+    {"lock_release_s", "s", "blend-out time of a released foot lock", 0.02f, 0.5f, K::kFloat,
+     &P::lock_release_s},
+    {"max_leg_stretch", "x leg", "a lock needing a longer leg than this is released", 0.9f, 1.0f,
+     K::kFloat, &P::max_leg_stretch},
+    {"idle_step_distance_m", "m", "standing: foot drift that makes the agent re-plant it", 0.02f, 0.5f,
+     K::kFloat, &P::idle_step_distance_m},
+    {"idle_step_angle_deg", "deg", "standing: pelvis-to-foot yaw that makes the agent step", 5.0f,
+     90.0f, K::kFloat, &P::idle_step_angle_deg},
+    {"idle_step_time_s", "s", "duration of a re-planting step while standing or turning", 0.1f, 1.0f,
+     K::kFloat, &P::idle_step_time_s},
+    {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator", 0.0f,
+     1.0f, K::kBool, nullptr, &P::feedback},
+    {"stride_variation", "x", "per-agent spread of stride length (crowd variety)", 0.0f, 0.2f,
+     K::kFloat, &P::stride_variation},
+};
+
+Status set_value(const ParamInfo& info, double value, const std::string& where, P* params) {
+  if (!std::isfinite(value) || value < info.min_value || value > info.max_value) {
+    std::ostringstream os;
+    os << where << ": expected " << info.min_value << ".." << info.max_value << " " << info.unit
+       << ", got " << value;
+    return Status::Error(os.str());
+  }
+  if (info.kind == K::kBool) {
+    params->*info.b = value != 0.0;
+  } else {
+    params->*info.f = static_cast<float>(value);
+  }
+  return Status::Ok();
+}
+
+const ParamInfo* find_info(std::string_view name) {
+  for (const ParamInfo& i : kInfos) {
+    if (name == i.name) return &i;
+  }
+  return nullptr;
+}
+
+std::string known_names() {
+  std::string s = "mode, seed";
+  for (const ParamInfo& i : kInfos) s += std::string(", ") + i.name;
+  return s;
+}
+
+}  // namespace
+
+std::string_view mediator_mode_name(MediatorMode mode) {
+  switch (mode) {
+    case MediatorMode::kNaive: return "naive";
+    case MediatorMode::kRate: return "rate";
+    case MediatorMode::kApm: return "apm";
+  }
+  return "?";
+}
+
+Result<MediatorMode> parse_mediator_mode(std::string_view name) {
+  if (name == "naive") return MediatorMode::kNaive;
+  if (name == "rate") return MediatorMode::kRate;
+  if (name == "apm") return MediatorMode::kApm;
+  return Status::Error("mode: expected naive, rate or apm, got '" + std::string(name) + "'");
+}
+
+std::span<const ParamInfo> mediator_param_infos() { return kInfos; }
+
+Status set_mediator_param(std::string_view assignment, MediatorParams* params) {
+  const size_t eq = assignment.find('=');
+  if (eq == std::string_view::npos) {
+    return Status::Error("--set '" + std::string(assignment) + "': expected name=value");
+  }
+  const std::string name(assignment.substr(0, eq));
+  const std::string text(assignment.substr(eq + 1));
+  if (name == "mode") {
+    Result<MediatorMode> m = parse_mediator_mode(text);
+    if (!m.ok()) return m.status();
+    params->mode = *m;
+    return Status::Ok();
+  }
+  if (name == "seed") {
+    try {
+      size_t used = 0;
+      const unsigned long long v = std::stoull(text, &used);
+      if (used != text.size()) throw std::invalid_argument("trailing");
+      params->seed = v;
+      return Status::Ok();
+    } catch (const std::exception&) {
+      return Status::Error("seed: expected a non-negative integer, got '" + text + "'");
+    }
+  }
+  const ParamInfo* info = find_info(name);
+  if (!info) {
+    return Status::Error("--set " + name + ": unknown parameter (known: " + known_names() + ")");
+  }
+  double value = 0.0;
+  if (info->kind == K::kBool && (text == "true" || text == "on" || text == "1")) {
+    value = 1.0;
+  } else if (info->kind == K::kBool && (text == "false" || text == "off" || text == "0")) {
+    value = 0.0;
+  } else {
+    try {
+      size_t used = 0;
+      value = std::stod(text, &used);
+      if (used != text.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      return Status::Error(name + ": expected a number in " + info->unit + ", got '" + text + "'");
+    }
+  }
+  GK_RETURN_IF_ERROR(set_value(*info, value, name, params));
+  return validate_mediator_params(*params);
+}
+
+Status load_mediator_params_json(const std::string& path, MediatorParams* params) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open parameter file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    return Status::Error(path + ": invalid JSON: " + e.what());
+  }
+  if (!j.is_object()) return Status::Error(path + ": expected a JSON object of parameters");
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string where = path + ": " + it.key();
+    if (it.key() == "mode") {
+      if (!it->is_string()) return Status::Error(where + ": expected \"naive\", \"rate\" or \"apm\"");
+      Result<MediatorMode> m = parse_mediator_mode(it->get<std::string>());
+      if (!m.ok()) return Status::Error(path + ": " + m.message());
+      params->mode = *m;
+      continue;
+    }
+    if (it.key() == "seed") {
+      if (!it->is_number_unsigned()) return Status::Error(where + ": expected a non-negative integer");
+      params->seed = it->get<uint64_t>();
+      continue;
+    }
+    const ParamInfo* info = find_info(it.key());
+    if (!info) return Status::Error(where + ": unknown parameter (known: " + known_names() + ")");
+    double value;
+    if (info->kind == K::kBool && it->is_boolean()) {
+      value = it->get<bool>() ? 1.0 : 0.0;
+    } else if (it->is_number()) {
+      value = it->get<double>();
+    } else {
+      return Status::Error(where + ": expected a " +
+                           (info->kind == K::kBool ? std::string("boolean") : "number in " +
+                                                                                 std::string(info->unit)));
+    }
+    GK_RETURN_IF_ERROR(set_value(*info, value, where, params));
+  }
+  const Status v = validate_mediator_params(*params);
+  if (!v.ok()) return Status::Error(path + ": " + v.message());
+  return Status::Ok();
+}
+
+Status validate_mediator_params(const MediatorParams& p) {
+  if (p.min_playback_rate > p.max_playback_rate) {
+    return Status::Error("min_playback_rate must not exceed max_playback_rate");
+  }
+  return Status::Ok();
+}
+
+}  // namespace gk

@@ -1,0 +1,70 @@
+#pragma once
+// Every parameter of the Animation Planning Mediator, with unit, default and limits, in one struct.
+// The app's panel and the CLI (`--set name=value`, or a JSON file) set them through the descriptor
+// table below, so names, units and limits are written once.
+
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "common/status.h"
+
+namespace gk {
+
+enum class MediatorMode : uint8_t {
+  kNaive,  // root at p facing v, nearest-speed clip at its native rate: the classic skating crowd
+  kRate,   // nearest-speed clip, playback rate matched to speed (within the rate limits) only
+  kApm,    // everything: blending, phase sync, stride warping, torso decoupling, foot locking
+};
+std::string_view mediator_mode_name(MediatorMode mode);
+Result<MediatorMode> parse_mediator_mode(std::string_view name);
+
+struct MediatorParams {
+  // 1. Input filtering (critically damped springs).
+  float velocity_halflife_s = 0.12f;  // [s] [Limit: 0.01..1] smoothing of the simulator's v
+  float theta_halflife_s = 0.15f;     // [s] [Limit: 0.01..1] smoothing of the desired torso theta
+  // 3. Torso decoupling.
+  float torsion_limit_deg = 60.0f;    // [deg] [Limit: 0..90] max twist pelvis -> upper chest
+  float lower_turn_rate_deg_s = 300.0f;  // [deg/s] [Limit: 30..1440] max lower-body turn rate
+  // 4./6. Blending.
+  float blend_time_s = 0.25f;         // [s] [Limit: 0.05..1] cross-fade duration on clip changes
+  // 5. Playback rate and stride warping.
+  float min_playback_rate = 0.7f;     // [ratio] [Limit: 0.1..1] slowest clip-time step / real time
+  float max_playback_rate = 1.35f;    // [ratio] [Limit: 1..3] fastest clip-time step / real time
+  float max_stride_warp = 0.2f;       // [ratio] [Limit: 0..0.5] stride length change taken by IK
+  float stop_speed_m_s = 0.08f;       // [m/s] [Limit: 0..0.5] below this the agent stands
+  // 7. Foot locking.
+  bool foot_locking = true;
+  float lock_release_s = 0.12f;       // [s] [Limit: 0.02..0.5] blend-out time of a released lock
+  float max_leg_stretch = 0.995f;     // [ratio of leg length] [Limit: 0.9..1] locks beyond release
+  float idle_step_distance_m = 0.12f; // [m] [Limit: 0.02..0.5] planted-foot drift that triggers a step
+  float idle_step_angle_deg = 30.0f;  // [deg] [Limit: 5..90] pelvis-foot yaw that triggers a step
+  float idle_step_time_s = 0.35f;     // [s] [Limit: 0.1..1] duration of a re-planting step
+  // 8. Feedback to the simulator.
+  bool feedback = true;
+  // Variety.
+  float stride_variation = 0.05f;     // [ratio] [Limit: 0..0.2] per-agent clip speed spread
+  uint64_t seed = 1;
+  MediatorMode mode = MediatorMode::kApm;
+};
+
+// Descriptor of one parameter for the CLI and the panel.
+struct ParamInfo {
+  const char* name;
+  const char* unit;
+  const char* help;  // one line: what it does
+  float min_value;
+  float max_value;
+  enum class Kind : uint8_t { kFloat, kBool } kind;
+  float MediatorParams::*f = nullptr;
+  bool MediatorParams::*b = nullptr;
+};
+std::span<const ParamInfo> mediator_param_infos();
+
+// "torsion_limit_deg=40" or "foot_locking=false"; errors name the parameter and its limits.
+Status set_mediator_param(std::string_view assignment, MediatorParams* params);
+// {"torsion_limit_deg": 40, "mode": "apm", ...}; errors name the file and the field.
+Status load_mediator_params_json(const std::string& path, MediatorParams* params);
+Status validate_mediator_params(const MediatorParams& params);
+
+}  // namespace gk

@@ -1,0 +1,90 @@
+#pragma once
+// Pose synthesis over the whole crowd (ARCHITECTURE.md step 7 and the pose stage): per agent,
+// sample and blend the planned clips, place the root, twist the spine toward the upper-body facing
+// within the torsion limit, pin planted feet with two-bone IK, and produce world joint transforms and
+// skinning palettes. Parallel over agents; all buffers sized at construction.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat4x4.hpp>
+
+#include "mediator/locomotion_library.h"
+#include "mediator/mediator.h"
+
+namespace gk {
+
+enum class FootLockState : uint8_t { kFree, kLocked, kReleasing, kStepping };
+
+struct FootLocks {
+  std::vector<uint8_t> state;      // FootLockState, [slot * 2 + side]
+  std::vector<glm::vec3> target;   // locked toe position (world) [m]
+  std::vector<glm::vec3> from;     // stepping: where the step started
+  std::vector<float> weight;       // IK weight 0..1
+  std::vector<float> timer;        // stepping progress [s]
+};
+
+class PoseSynthesizer {
+ public:
+  PoseSynthesizer(const LocomotionLibrary& library, size_t capacity, bool make_palettes);
+
+  // Synthesises every live agent of the mediator's last plan.
+  void run(const Mediator& mediator, float dt_s);
+
+  int num_joints() const { return num_joints_; }
+  // World transforms of one slot's joints, as rendered.
+  std::span<const glm::mat4> world(int slot) const {
+    return {world_.data() + static_cast<size_t>(slot) * num_joints_, static_cast<size_t>(num_joints_)};
+  }
+  std::span<const glm::mat4> palette(int slot) const {
+    return {palette_.data() + static_cast<size_t>(slot) * num_joints_, static_cast<size_t>(num_joints_)};
+  }
+  std::span<const glm::quat> local_rotations(int slot) const {
+    return {local_rot_.data() + static_cast<size_t>(slot) * num_joints_, static_cast<size_t>(num_joints_)};
+  }
+  // Largest change of any joint's local rotation since the slot's previous frame [rad] (0 on an
+  // agent's first frame).
+  float max_rotation_change(int slot) const { return rot_change_[slot]; }
+  const FootLocks& foot_locks() const { return locks_; }
+  // Final torsion pelvis -> chest [rad], signed, per slot.
+  float torsion(int slot) const { return torsion_[slot]; }
+  // Ground headings [rad] of the pelvis and the upper chest (rest-pose relative), per slot.
+  float pelvis_heading(int slot) const { return pelvis_heading_[slot]; }
+  float upper_heading(int slot) const { return upper_heading_[slot]; }
+  const std::vector<glm::mat4>& inverse_bind() const { return inverse_bind_; }
+
+ private:
+  struct Scratch;
+  void synthesize_agent(const Mediator& m, int slot, float dt, Scratch& s);
+  void fk_from(int slot, int first_joint, const glm::mat4& root);
+  void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
+  void lock_feet(const Mediator& m, int slot, const glm::mat4& root, float dt);
+
+  const LocomotionLibrary& library_;
+  const Skeleton& skeleton_;
+  int num_joints_;
+  bool make_palettes_;
+  std::vector<glm::quat> rest_model_rot_inv_;  // inverse rest model rotations: rest-relative forward
+  std::vector<glm::mat4> inverse_bind_;
+  std::vector<glm::quat> local_rot_;
+  std::vector<glm::vec3> local_trans_;
+  std::vector<glm::quat> prev_local_rot_;
+  std::vector<glm::mat4> world_;
+  std::vector<glm::mat4> palette_;
+  std::vector<float> rot_change_;
+  std::vector<float> torsion_;
+  std::vector<float> pelvis_heading_;
+  std::vector<float> upper_heading_;
+  std::vector<uint8_t> has_prev_;
+  FootLocks locks_;
+  int first_leg_joint_ = 0;
+  int first_spine_joint_ = 0;
+};
+
+// Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
+// +z): heading [rad].
+float joint_heading(const glm::mat4& world, const glm::quat& rest_model_rot_inv);
+
+}  // namespace gk

@@ -1,0 +1,41 @@
+#pragma once
+// Critically damped springs (exact integration, stable for any dt): the simulator's velocity and
+// torso orientation are filtered through them so zig-zag never reaches the body.
+
+#include <cmath>
+#include <numbers>
+
+#include <glm/vec2.hpp>
+
+namespace gk {
+
+// Damping of a critically damped spring that halves its error every halflife_s seconds.
+inline float halflife_to_damping(float halflife_s) {
+  return (4.0f * std::numbers::ln2_v<float>) / (halflife_s + 1e-5f);
+}
+
+template <typename T>
+inline void critical_spring(T& x, T& v, const T& goal, float halflife_s, float dt) {
+  const float y = halflife_to_damping(halflife_s) * 0.5f;
+  const T j0 = x - goal;
+  const T j1 = v + j0 * y;
+  const float eydt = std::exp(-y * dt);
+  x = eydt * (j0 + j1 * dt) + goal;
+  v = eydt * (v - j1 * y * dt);
+}
+
+inline float wrap_pi(float a) {
+  constexpr float kPi = std::numbers::pi_v<float>;
+  a = std::fmod(a + kPi, 2.0f * kPi);
+  if (a < 0.0f) a += 2.0f * kPi;
+  return a - kPi;
+}
+
+// Moves angle a toward b by at most max_step (shortest way round).
+inline float approach_angle(float a, float b, float max_step) {
+  const float d = wrap_pi(b - a);
+  if (std::abs(d) <= max_step) return b;
+  return a + (d > 0.0f ? max_step : -max_step);
+}
+
+}  // namespace gk

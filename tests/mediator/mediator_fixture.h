@@ -1,0 +1,57 @@
+#pragma once
+// Runs the mediator and pose synthesis over a scripted crowd and returns the METRICS.md report.
+
+#include <memory>
+
+#include "animation/procedural.h"
+#include "mediator/mediator.h"
+#include "mediator/metrics.h"
+#include "mediator/pose_synthesis.h"
+#include "tests/mediator/scripted_crowd.h"
+
+namespace gk::test {
+
+inline const LocomotionLibrary& builtin_library() {
+  static const LocomotionLibrary lib = [] {
+    std::vector<ClipSet> sets{make_builtin_clip_set()};
+    Result<LocomotionLibrary> r = build_locomotion_library(sets);
+    if (!r.ok()) throw std::runtime_error(r.message());
+    return std::move(*r);
+  }();
+  return lib;
+}
+
+struct RunResult {
+  MetricsReport report;
+  uint64_t sanitised = 0;
+  int feedback_frames = 0;
+};
+
+inline RunResult run_scripted(const LocomotionLibrary& lib, std::vector<Script> scripts,
+                              MediatorParams params, int frames = 600, bool honour = false) {
+  constexpr float kDt = 1.0f / 60.0f;
+  ScriptedCrowd crowd(std::move(scripts), honour);
+  Mediator mediator(lib, params, crowd.capacity());
+  PoseSynthesizer poses(lib, crowd.capacity(), false);
+  MetricsRecorder metrics(lib, kDt, crowd.capacity(), frames);
+  RunResult out;
+  for (int f = 0; f < frames; ++f) {
+    EXPECT_TRUE(crowd.step(kDt).ok());
+    const AgentFrame frame = crowd.frame();
+    const Status s = mediator.plan(frame, kDt);
+    EXPECT_TRUE(s.ok()) << s.message();
+    poses.run(mediator, kDt);
+    metrics.record(frame, mediator, poses);
+    EXPECT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
+    out.feedback_frames += crowd.last_feedback_count() > 0;
+  }
+  out.report = metrics.finish();
+  out.sanitised = mediator.num_sanitised();
+  return out;
+}
+
+inline Script straight(glm::vec2 start, glm::vec2 velocity) {
+  return {start, [velocity](double) { return velocity; }, nullptr};
+}
+
+}  // namespace gk::test
