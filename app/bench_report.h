@@ -1,0 +1,99 @@
+#pragma once
+// The benchmark report of `gaitkeeper bench` (schema in docs METRICS.md, "Report schema"): stage
+// timings per frame, the crowd's statistics and, once the mediator exists, the metrics. Values
+// that were not measured are std::nullopt and serialise as JSON null, never as 0.
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "common/status.h"
+
+namespace gk::app {
+
+// The pipeline stages of METRICS.md, in report order. kTotal is the whole frame.
+enum class Stage : uint8_t { kSim, kMediator, kPose, kUpload, kRender, kTotal };
+inline constexpr size_t kNumStages = 6;
+const char* stage_name(Stage stage);
+
+struct TimingStat {
+  double median_ms = 0.0;
+  double p95_ms = 0.0;
+};
+
+// Collects one duration per stage per frame, ignoring the first `warmup_frames` frames (caches,
+// page faults, thread start-up). Storage is reserved up front so timing does not allocate.
+class StageTimer {
+ public:
+  using Clock = std::chrono::steady_clock;
+  StageTimer(int warmup_frames, int expected_frames);
+
+  void record(Stage stage, int frame, double ms);
+  // Runs fn() and records its duration for `stage` on `frame`; returns what fn returns.
+  template <typename Fn>
+  auto time(Stage stage, int frame, Fn&& fn) {
+    const auto start = Clock::now();
+    if constexpr (std::is_void_v<decltype(fn())>) {
+      fn();
+      record(stage, frame, ms_since(start));
+    } else {
+      auto result = fn();
+      record(stage, frame, ms_since(start));
+      return result;
+    }
+  }
+  static double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  }
+  // Median and 95th percentile (nearest rank) of a stage; nullopt when it never ran after warm-up.
+  std::optional<TimingStat> stat(Stage stage) const;
+  int warmup_frames() const { return warmup_frames_; }
+
+ private:
+  int warmup_frames_;
+  std::array<std::vector<double>, kNumStages> samples_ms_;
+};
+
+// Agent statistics over the run (all frames, warm-up included).
+struct CrowdReport {
+  double mean_live_agents = 0.0;
+  int64_t max_live_agents = 0;
+  double mean_speed_m_s = 0.0;  // over all agent-frames
+  double max_speed_m_s = 0.0;
+  std::optional<int64_t> reached_goal;  // agents that reached their final waypoint (social only)
+  std::optional<int64_t> removed;       // agents removed at their goal (social only)
+  // Smallest centre distance below kMinPairSearch_m found on the sampled frames; null if none.
+  std::optional<double> min_pair_distance_m;
+  int pair_distance_every_frames = 10;
+};
+
+struct BenchReport {
+  std::string gaitkeeper_version;
+  std::string scenario;
+  std::string mode = "crowd-only";  // no mediator yet; later "apm", "naive", ...
+  std::string sim;                  // CrowdSource::name()
+  int64_t agents = 0;
+  int64_t frames = 0;
+  double frame_time_s = 1.0 / 60.0;
+  int threads = 1;
+  uint64_t seed = 1;
+  std::optional<int> joints;  // skeleton joint count once poses are synthesised
+  std::vector<std::string> clips;
+  std::array<std::optional<TimingStat>, kNumStages> timing_ms;
+  std::optional<double> us_per_agent;     // median total / agents * 1000
+  std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists
+  std::optional<CrowdReport> crowd;
+};
+
+nlohmann::json to_json(const BenchReport& report);
+Status write_report_json(const BenchReport& report, const std::string& path);
+// Human-readable summary for stdout.
+std::string summary(const BenchReport& report);
+
+}  // namespace gk::app

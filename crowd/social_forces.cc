@@ -1,0 +1,432 @@
+#include "crowd/social_forces.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "crowd/spatial_grid.h"
+
+namespace gk {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kWallReach = 1.5f;   // walls listed per cell: covers a step plus a body [m]
+constexpr float kGridMargin = 5.0f;  // agent grid extends this far past everything known [m]
+constexpr size_t kGrain = 512;       // agents per parallel task: amortises scheduling
+
+float wrap_angle(float a) {
+  a = std::remainder(a, 2.0f * kPi);
+  return a;
+}
+// theta convention of crowd_source.h: 0 faces +z, pi/2 faces +x.
+float angle_of(glm::vec2 d) { return std::atan2(d.x, d.y); }
+bool finite(glm::vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+Status check_range(bool ok, const char* name, const char* expected) {
+  return ok ? Status::Ok()
+            : Status::Error(std::string("SocialForceParams::") + name + ": expected " + expected);
+}
+
+}  // namespace
+
+Status validate(const SocialForceParams& p) {
+  GK_RETURN_IF_ERROR(check_range(p.relaxation_time_s > 0.01f && p.relaxation_time_s <= 100.0f,
+                                 "relaxation_time_s", "a value in (0.01, 100]"));
+  GK_RETURN_IF_ERROR(check_range(p.max_speed_factor >= 1.0f && p.max_speed_factor <= 10.0f,
+                                 "max_speed_factor", "a value in [1, 10]"));
+  GK_RETURN_IF_ERROR(check_range(p.agent_strength_m_s2 >= 0.0f && p.agent_strength_m_s2 <= 1e3f,
+                                 "agent_strength_m_s2", "a value in [0, 1000]"));
+  GK_RETURN_IF_ERROR(check_range(p.agent_range_m >= 0.05f && p.agent_range_m <= 10.0f,
+                                 "agent_range_m", "a value in [0.05, 10]"));
+  GK_RETURN_IF_ERROR(check_range(p.field_of_view_weight >= 0.0f && p.field_of_view_weight <= 1.0f,
+                                 "field_of_view_weight", "a value in [0, 1]"));
+  GK_RETURN_IF_ERROR(check_range(p.anticipation_time_s >= 0.0f && p.anticipation_time_s <= 5.0f,
+                                 "anticipation_time_s", "a value in [0, 5]"));
+  GK_RETURN_IF_ERROR(
+      check_range(p.side_step >= 0.0f && p.side_step <= 1.0f, "side_step", "a value in [0, 1]"));
+  GK_RETURN_IF_ERROR(check_range(p.neighbour_radius_m > 0.1f && p.neighbour_radius_m <= 20.0f,
+                                 "neighbour_radius_m", "a value in (0.1, 20]"));
+  GK_RETURN_IF_ERROR(check_range(p.wall_strength_m_s2 >= 0.0f && p.wall_strength_m_s2 <= 1e3f,
+                                 "wall_strength_m_s2", "a value in [0, 1000]"));
+  GK_RETURN_IF_ERROR(check_range(p.wall_range_m >= 0.02f && p.wall_range_m <= 10.0f, "wall_range_m",
+                                 "a value in [0.02, 10]"));
+  GK_RETURN_IF_ERROR(check_range(p.wall_radius_m > 0.0f && p.wall_radius_m <= 20.0f,
+                                 "wall_radius_m", "a value in (0, 20]"));
+  GK_RETURN_IF_ERROR(check_range(p.body_stiffness_s2 >= 0.0f && p.body_stiffness_s2 <= 1e5f,
+                                 "body_stiffness_s2", "a value in [0, 1e5]"));
+  GK_RETURN_IF_ERROR(
+      check_range(p.heading_time_s > 0.0f && p.heading_speed_m_s > 0.0f && p.look_time_s > 0.0f,
+                  "heading_time_s/heading_speed_m_s/look_time_s", "values > 0"));
+  GK_RETURN_IF_ERROR(check_range(p.max_look_twist_deg >= 0.0f && p.max_look_twist_deg <= 180.0f,
+                                 "max_look_twist_deg", "a value in [0, 180]"));
+  GK_RETURN_IF_ERROR(check_range(p.threads >= 0 && p.threads <= 256, "threads", "0 to 256"));
+  GK_RETURN_IF_ERROR(
+      check_range(p.max_agents >= 1 && p.max_agents <= 1'000'000, "max_agents", "1 to 1000000"));
+  return check_range(p.max_feedback_speed_m_s > 0.0f && p.max_feedback_jump_m > 0.0f,
+                     "max_feedback_speed_m_s/max_feedback_jump_m", "values > 0");
+}
+
+struct SocialForces::Impl {
+  UniformGrid grid;
+  WallGrid walls;
+  std::unique_ptr<tbb::task_arena> arena;  // null when single-threaded
+  std::atomic<bool> non_finite{false};
+};
+
+SocialForces::SocialForces(const SocialForceParams& params, size_t capacity)
+    : params_(params), capacity_(capacity) {}
+SocialForces::~SocialForces() = default;
+
+Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scenario,
+                                                           const ScenarioAgents& agents,
+                                                           const SocialForceParams& params) {
+  GK_RETURN_IF_ERROR(validate(params));
+  const size_t n = agents.size();
+  const std::string where = "social forces (" + scenario.name + "): ";
+  if (n > params.max_agents) {
+    return Status::Error(where + std::to_string(n) + " agents exceed max_agents " +
+                         std::to_string(params.max_agents) + " (SocialForceParams::max_agents)");
+  }
+  auto optional_ok = [n](size_t size) { return size == 0 || size == n; };
+  if (agents.desired_speeds_m_s.size() != n || agents.radii_m.size() != n ||
+      agents.loop_waypoints.size() != n ||
+      (agents.waypoint_begin.size() != n + 1 && !(n == 0 && agents.waypoint_begin.empty())) ||
+      (n > 0 && agents.waypoint_begin.back() > agents.waypoints.size()) ||
+      !optional_ok(agents.remove_at_goal.size()) || !optional_ok(agents.goal_radii_m.size()) ||
+      !optional_ok(agents.attentive.size())) {
+    return Status::Error(where + "inconsistent ScenarioAgents array sizes");
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const bool ok = finite(agents.positions[i]) && agents.desired_speeds_m_s[i] > 0.0f &&
+                    agents.desired_speeds_m_s[i] <= 10.0f && agents.radii_m[i] > 0.0f &&
+                    agents.radii_m[i] <= 1.0f &&
+                    agents.waypoint_begin[i] <= agents.waypoint_begin[i + 1] &&
+                    (agents.goal_radii_m.empty() || agents.goal_radii_m[i] > 0.0f);
+    if (!ok) return Status::Error(where + "agent " + std::to_string(i) + ": invalid initial state");
+  }
+  for (const glm::vec2& w : agents.waypoints) {
+    if (!finite(w)) return Status::Error(where + "non-finite waypoint");
+  }
+
+  std::unique_ptr<SocialForces> sim(new SocialForces(params, n));
+  SocialForces& s = *sim;
+  glm::vec2 lo = scenario.bounds_min, hi = scenario.bounds_max;
+  for (const glm::vec2& p : agents.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  for (const glm::vec2& p : agents.waypoints) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  auto grid = UniformGrid::create(lo - kGridMargin, hi + kGridMargin, params.neighbour_radius_m, n);
+  if (!grid.ok()) return Status::Error(where + grid.message());
+  s.impl_ = std::make_unique<Impl>();
+  s.impl_->grid = std::move(grid).value();
+  s.impl_->walls = WallGrid(scenario.walls, 2.0f, std::max(params.wall_radius_m, kWallReach));
+  if (params.threads != 1) {
+    s.impl_->arena = std::make_unique<tbb::task_arena>(
+        params.threads == 0 ? static_cast<int>(tbb::task_arena::automatic) : params.threads);
+  }
+  s.targets_ = scenario.attention_targets;
+  s.waypoints_ = agents.waypoints;
+  s.num_ = n;
+  s.id_.resize(n);
+  s.position_ = agents.positions;
+  s.velocity_.assign(n, glm::vec2(0.0f));
+  s.theta_.resize(n);
+  s.heading_.resize(n);
+  s.desired_speed_ = agents.desired_speeds_m_s;
+  s.max_speed_.resize(n);
+  s.radius_ = agents.radii_m;
+  s.goal_radius_.assign(n, 0.5f);
+  s.waypoint_.resize(n);
+  s.waypoint_begin_.resize(n);
+  s.waypoint_end_.resize(n);
+  s.loop_ = agents.loop_waypoints;
+  s.remove_at_goal_.assign(n, 0);
+  s.attentive_.assign(n, 1);
+  s.arrived_.assign(n, 0);
+  s.reached_.assign(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    s.id_[i] = static_cast<uint32_t>(i);
+    s.max_speed_[i] = params.max_speed_factor * s.desired_speed_[i];
+    if (!agents.goal_radii_m.empty()) s.goal_radius_[i] = agents.goal_radii_m[i];
+    if (!agents.remove_at_goal.empty()) s.remove_at_goal_[i] = agents.remove_at_goal[i];
+    if (!agents.attentive.empty()) s.attentive_[i] = agents.attentive[i];
+    s.waypoint_begin_[i] = s.waypoint_[i] = agents.waypoint_begin[i];
+    s.waypoint_end_[i] = agents.waypoint_begin[i + 1];
+    s.arrived_[i] = s.waypoint_begin_[i] == s.waypoint_end_[i] ? 1 : 0;  // nowhere to go: stand
+    const glm::vec2 to_goal =
+        s.arrived_[i] ? glm::vec2(0.0f, 1.0f) : s.waypoints_[s.waypoint_[i]] - s.position_[i];
+    s.heading_[i] = s.theta_[i] = glm::dot(to_goal, to_goal) > 0.0f ? angle_of(to_goal) : 0.0f;
+  }
+  s.new_velocity_.resize(n);
+  s.sorted_position_.resize(n);
+  s.sorted_velocity_.resize(n);
+  s.sorted_radius_.resize(n);
+  return sim;
+}
+
+template <typename Fn>
+void SocialForces::for_agents(Fn&& fn) {
+  if (!impl_->arena) {
+    fn(size_t{0}, num_);
+    return;
+  }
+  impl_->arena->execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, num_, kGrain),
+                      [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); });
+  });
+}
+
+Status SocialForces::step(float dt_s) {
+  if (!(dt_s > 0.0f && dt_s <= 0.5f)) {
+    return Status::Error("social forces: step dt_s " + std::to_string(dt_s) +
+                         ": expected a value in (0, 0.5]");
+  }
+  impl_->grid.build({position_.data(), num_});
+  const auto order = impl_->grid.order();
+  for (size_t k = 0; k < num_; ++k) {  // gather in cell order: neighbours become contiguous
+    sorted_position_[k] = position_[order[k]];
+    sorted_velocity_[k] = velocity_[order[k]];
+    sorted_radius_[k] = radius_[order[k]];
+  }
+  impl_->non_finite.store(false, std::memory_order_relaxed);
+  for_agents([&](size_t b, size_t e) { compute_velocities(b, e, dt_s); });
+  for_agents([&](size_t b, size_t e) { commit(b, e, dt_s); });
+  remove_finished();
+  time_s_ += dt_s;
+  if (impl_->non_finite.load(std::memory_order_relaxed)) {
+    return Status::Error("social forces: non-finite velocity computed (agents held in place)");
+  }
+  return Status::Ok();
+}
+
+// Pass 1: new velocity of the agents at sorted positions [begin, end), from the frozen state.
+void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
+  const UniformGrid& grid = impl_->grid;
+  const auto order = grid.order();
+  const SocialForceParams& p = params_;
+  const float inv_tau = 1.0f / p.relaxation_time_s;
+  const float inv_b = 1.0f / p.agent_range_m;
+  const float inv_bw = 1.0f / p.wall_range_m;
+  const float cutoff2 = p.neighbour_radius_m * p.neighbour_radius_m;
+  const float wall_cutoff2 = p.wall_radius_m * p.wall_radius_m;
+  const float lambda = p.field_of_view_weight;
+  const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
+  for (size_t k = begin; k < end; ++k) {
+    const uint32_t i = order[k];
+    const glm::vec2 pos = sorted_position_[k];
+    const glm::vec2 vel = sorted_velocity_[k];
+    const float r_i = sorted_radius_[k];
+    glm::vec2 dir(0.0f);  // desired direction e
+    if (!arrived_[i]) {
+      const glm::vec2 to_goal = waypoints_[waypoint_[i]] - pos;
+      const float len = glm::length(to_goal);
+      if (len > 1e-6f) dir = to_goal / len;
+    }
+    glm::vec2 acc = (desired_speed_[i] * dir - vel) * inv_tau;
+    // Facing for the field of view: the velocity, or the desired direction when (nearly) still.
+    const float speed = glm::length(vel);
+    const glm::vec2 facing = speed > 0.1f ? vel / speed : dir;
+    const glm::vec2 right(-facing.y, facing.x);
+    const auto [cx, cz] = grid.cell_of(pos);
+    for (int z = cz - 1; z <= cz + 1; ++z) {
+      const auto [m0, m1] = grid.row_range(z, cx - 1, cx + 1);
+      for (uint32_t m = m0; m < m1; ++m) {
+        const glm::vec2 d = pos - sorted_position_[m];
+        const float d2 = glm::dot(d, d);
+        if (d2 >= cutoff2 || m == k) continue;
+        glm::vec2 n;
+        float dist;
+        if (d2 > 1e-12f) {
+          dist = std::sqrt(d2);
+          n = d / dist;
+        } else {  // same spot: separate by id so the pair pushes apart symmetrically
+          dist = 0.0f;
+          n = glm::vec2(id_[i] < id_[order[m]] ? -1.0f : 1.0f, 0.0f);
+        }
+        const float overlap = r_i + sorted_radius_[m] - dist;
+        const float cos_phi = -glm::dot(n, facing);  // 1: the other is straight ahead
+        const float w = lambda + (1.0f - lambda) * 0.5f * (1.0f + cos_phi);
+        // Elliptical specification II (Johansson, Helbing & Shukla 2007): the distance is replaced
+        // by the semi-minor axis b of an ellipse through p_i with foci at p_j and at p_j moved by
+        // the relative velocity over the anticipation time, so agents on a collision course repel
+        // early and sideways, while agents walking alongside barely interact.
+        const glm::vec2 y = (sorted_velocity_[m] - vel) * p.anticipation_time_s;
+        const glm::vec2 dy = d - y;
+        const float dy_len = std::sqrt(glm::dot(dy, dy));
+        const float sum = dist + dy_len;
+        const float b = 0.5f * std::sqrt(std::max(sum * sum - glm::dot(y, y), 0.0f));
+        // The potential's gradient grows as sum / 2b; capping b keeps it finite when the other is
+        // predicted to pass right through p_i.
+        const float stretch = sum / (2.0f * std::max(b, 0.1f * sum + 1e-6f));
+        const glm::vec2 dir = 0.5f * (n + (dy_len > 1e-6f ? dy / dy_len : n));
+        const float repulsion =
+            p.agent_strength_m_s2 * std::exp((r_i + sorted_radius_[m] - b) * inv_b) * w * stretch;
+        acc += repulsion * dir;
+        if (cos_phi > 0.0f) acc += (p.side_step * repulsion * cos_phi) * right;
+        if (overlap > 0.0f) acc += (stiffness * overlap) * n;
+      }
+    }
+    for (const uint32_t wi : impl_->walls.near(pos)) {
+      const WallSegment& wall = impl_->walls.walls()[wi];
+      const glm::vec2 d = pos - closest_point_on_segment(pos, wall.a, wall.b);
+      const float d2 = glm::dot(d, d);
+      if (d2 >= wall_cutoff2 || d2 < 1e-12f) continue;  // on the wall: the commit pass pushes out
+      const float dist = std::sqrt(d2);
+      const glm::vec2 n = d / dist;
+      const float overlap = r_i - dist;
+      acc += (p.wall_strength_m_s2 * std::exp(overlap * inv_bw)) * n;
+      if (overlap > 0.0f) acc += (stiffness * overlap) * n;
+    }
+    glm::vec2 v_new = vel + acc * dt_s;
+    const float s2 = glm::dot(v_new, v_new);
+    if (s2 > max_speed_[i] * max_speed_[i]) v_new *= max_speed_[i] / std::sqrt(s2);
+    if (!finite(v_new)) {
+      impl_->non_finite.store(true, std::memory_order_relaxed);
+      v_new = glm::vec2(0.0f);
+    }
+    new_velocity_[i] = v_new;
+  }
+}
+
+// Pass 2: move agents [begin, end), keep them out of walls, advance waypoints, turn theta.
+void SocialForces::commit(size_t begin, size_t end, float dt_s) {
+  const float heading_rate = 1.0f - std::exp(-dt_s / params_.heading_time_s);
+  const float look_rate = 1.0f - std::exp(-dt_s / params_.look_time_s);
+  const float max_twist = params_.max_look_twist_deg * (kPi / 180.0f);
+  for (size_t i = begin; i < end; ++i) {
+    const glm::vec2 from = position_[i];
+    const glm::vec2 to =
+        impl_->walls.constrain_move(from, from + new_velocity_[i] * dt_s, radius_[i]);
+    glm::vec2 vel = (to - from) / dt_s;  // what the agent really did after the walls
+    const float s2 = glm::dot(vel, vel);
+    if (s2 > max_speed_[i] * max_speed_[i]) vel *= max_speed_[i] / std::sqrt(s2);
+    position_[i] = to;
+    velocity_[i] = vel;
+    if (!arrived_[i] && glm::length(waypoints_[waypoint_[i]] - to) < goal_radius_[i]) {
+      if (waypoint_[i] + 1 < waypoint_end_[i]) {
+        ++waypoint_[i];
+      } else {
+        reached_[i] = 1;
+        if (loop_[i]) {
+          waypoint_[i] = waypoint_begin_[i];
+        } else {
+          arrived_[i] = 1;
+        }
+      }
+    }
+    // Heading: exponential smoothing of the walking direction, slowed down in proportion to the
+    // speed below heading_speed_m_s so that jitter of a standing agent does not spin it.
+    const float speed = std::sqrt(glm::dot(vel, vel));
+    if (speed > 1e-4f) {
+      const float rate = heading_rate * std::min(1.0f, speed / params_.heading_speed_m_s);
+      heading_[i] = wrap_angle(heading_[i] + rate * wrap_angle(angle_of(vel) - heading_[i]));
+    }
+    float look = heading_[i];
+    if (attentive_[i]) {
+      float best = 0.0f;
+      for (const AttentionTarget& t : targets_) {
+        const glm::vec2 d = t.position - to;
+        const float d2 = glm::dot(d, d);
+        if (d2 >= t.radius_m * t.radius_m || (best > 0.0f && d2 >= best) || d2 < 1e-8f) continue;
+        const float toward = angle_of(d);
+        if (std::abs(wrap_angle(toward - heading_[i])) <= max_twist) {
+          look = toward;
+          best = d2;
+        }
+      }
+    }
+    theta_[i] = wrap_angle(theta_[i] + look_rate * wrap_angle(look - theta_[i]));
+  }
+}
+
+void SocialForces::remove_finished() {
+  size_t out = 0;
+  for (size_t i = 0; i < num_; ++i) {
+    if (arrived_[i] && remove_at_goal_[i]) {
+      ++removed_;
+      ++reached_removed_;
+      continue;
+    }
+    if (out != i) {
+      id_[out] = id_[i];
+      position_[out] = position_[i];
+      velocity_[out] = velocity_[i];
+      theta_[out] = theta_[i];
+      heading_[out] = heading_[i];
+      desired_speed_[out] = desired_speed_[i];
+      max_speed_[out] = max_speed_[i];
+      radius_[out] = radius_[i];
+      goal_radius_[out] = goal_radius_[i];
+      waypoint_[out] = waypoint_[i];
+      waypoint_begin_[out] = waypoint_begin_[i];
+      waypoint_end_[out] = waypoint_end_[i];
+      loop_[out] = loop_[i];
+      remove_at_goal_[out] = remove_at_goal_[i];
+      attentive_[out] = attentive_[i];
+      arrived_[out] = arrived_[i];
+      reached_[out] = reached_[i];
+    }
+    ++out;
+  }
+  num_ = out;
+}
+
+AgentFrame SocialForces::frame() const {
+  return AgentFrame{{id_.data(), num_},
+                    {position_.data(), num_},
+                    {velocity_.data(), num_},
+                    {theta_.data(), num_}};
+}
+
+SocialForceStats SocialForces::stats() const {
+  SocialForceStats s;
+  s.live = num_;
+  s.removed = removed_;
+  s.reached_goal = reached_removed_;
+  for (size_t i = 0; i < num_; ++i) s.reached_goal += reached_[i];
+  return s;
+}
+
+Status SocialForces::apply_feedback(const AgentFeedback& fb) {
+  if (fb.has_feedback.size() != num_ || fb.positions.size() != num_ ||
+      fb.velocities.size() != num_ || fb.thetas.size() != num_) {
+    return Status::Error("social forces: feedback for " + std::to_string(fb.has_feedback.size()) +
+                         " agents, expected " + std::to_string(num_) +
+                         " (all arrays index-aligned with frame())");
+  }
+  const float max_v = params_.max_feedback_speed_m_s, max_jump = params_.max_feedback_jump_m;
+  for (size_t i = 0; i < num_; ++i) {  // validate everything before changing anything
+    if (!fb.has_feedback[i]) continue;
+    const std::string who = "social forces: feedback for agent id " + std::to_string(id_[i]) + ": ";
+    if (!finite(fb.positions[i]) || !finite(fb.velocities[i]) || !std::isfinite(fb.thetas[i])) {
+      return Status::Error(who + "non-finite position, velocity or theta");
+    }
+    if (glm::length(fb.velocities[i]) > max_v) {
+      return Status::Error(who + "speed " + std::to_string(glm::length(fb.velocities[i])) +
+                           " m/s exceeds max_feedback_speed_m_s " + std::to_string(max_v));
+    }
+    if (glm::length(fb.positions[i] - position_[i]) > max_jump) {
+      return Status::Error(who + "position moves " +
+                           std::to_string(glm::length(fb.positions[i] - position_[i])) +
+                           " m, more than max_feedback_jump_m " + std::to_string(max_jump));
+    }
+  }
+  for (size_t i = 0; i < num_; ++i) {
+    if (!fb.has_feedback[i]) continue;
+    position_[i] = impl_->walls.constrain_move(position_[i], fb.positions[i], radius_[i]);
+    glm::vec2 v = fb.velocities[i];
+    const float s = glm::length(v);
+    if (s > max_speed_[i]) v *= max_speed_[i] / s;
+    velocity_[i] = v;
+    theta_[i] = wrap_angle(fb.thetas[i]);
+  }
+  return Status::Ok();
+}
+
+}  // namespace gk

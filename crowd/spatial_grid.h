@@ -1,0 +1,88 @@
+#pragma once
+// Uniform grids for the crowd: UniformGrid buckets moving points (agents) per step with a counting
+// sort, so a neighbour search is linear in the number of agents; WallGrid lists, once, the static
+// wall segments near each cell. Plus the segment geometry both need.
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "common/status.h"
+#include "crowd/scenario.h"
+
+namespace gk {
+
+glm::vec2 closest_point_on_segment(glm::vec2 p, glm::vec2 a, glm::vec2 b);
+float distance_to_segment(glm::vec2 p, glm::vec2 a, glm::vec2 b);
+// True when segment p0-p1 crosses or touches segment a-b. Evaluated in double precision because
+// it is the last line of defence of the no-wall-crossing guarantee.
+bool segments_intersect(glm::vec2 p0, glm::vec2 p1, glm::vec2 a, glm::vec2 b);
+
+class UniformGrid {
+ public:
+  // Cells cover [min, max] (grown when the cell count would exceed kMaxCells); points outside
+  // fall into the border cells, which stays correct and only costs time.
+  static constexpr size_t kMaxCells = size_t{1} << 22;
+  static Result<UniformGrid> create(glm::vec2 min, glm::vec2 max, float cell_size_m,
+                                    size_t capacity);
+
+  // Stable counting sort of the points into cells, O(points + cells). No allocation when
+  // points.size() <= capacity (asserted).
+  void build(std::span<const glm::vec2> points);
+
+  int num_x() const { return num_x_; }
+  int num_z() const { return num_z_; }
+  float cell_size() const { return cell_size_; }
+  // Cell of p, clamped to the grid; non-finite coordinates go to cell 0.
+  std::pair<int, int> cell_of(glm::vec2 p) const;
+  // Indices of the built points, ordered by cell (row-major, x fastest), within a cell by index.
+  std::span<const uint32_t> order() const { return {order_.data(), num_points_}; }
+  // Half-open range in order() covering cells x0..x1 (inclusive, clamped) of row z: one
+  // contiguous range, because rows are stored consecutively.
+  std::pair<uint32_t, uint32_t> row_range(int z, int x0, int x1) const;
+
+ private:
+  glm::vec2 min_{0.0f};
+  float cell_size_ = 1.0f;
+  float inv_cell_ = 1.0f;
+  int num_x_ = 1, num_z_ = 1;
+  size_t num_points_ = 0;
+  std::vector<uint32_t> cell_start_;  // num cells + 1
+  std::vector<uint32_t> cursor_;      // scratch of the scatter
+  std::vector<uint32_t> point_cell_;  // capacity
+  std::vector<uint32_t> order_;       // capacity
+};
+
+class WallGrid {
+ public:
+  WallGrid() = default;
+  // Lists for each cell every wall that comes within reach_m of it.
+  WallGrid(std::span<const WallSegment> walls, float cell_size_m, float reach_m);
+
+  // A superset of the walls within reach_m() of p; empty far from every wall.
+  std::span<const uint32_t> near(glm::vec2 p) const;
+  float reach() const { return reach_m_; }
+  std::span<const WallSegment> walls() const { return walls_; }
+  // Where a body of `radius` moving from `from` toward `to` may end up: a move that would cross a
+  // wall slides along it (or is cancelled), and the end point is pushed out to `radius` from
+  // nearby walls unless that push would itself cross a wall. The segment from `from` to the
+  // result never crosses a wall.
+  glm::vec2 constrain_move(glm::vec2 from, glm::vec2 to, float radius) const;
+  // Every wall index, for movements longer than reach().
+  std::span<const uint32_t> all() const { return all_; }
+
+ private:
+  std::vector<WallSegment> walls_;
+  std::vector<uint32_t> all_;
+  glm::vec2 min_{0.0f};
+  float inv_cell_ = 1.0f;
+  float reach_m_ = 0.0f;
+  int num_x_ = 0, num_z_ = 0;
+  std::vector<uint32_t> cell_start_;
+  std::vector<uint32_t> items_;
+};
+
+}  // namespace gk
