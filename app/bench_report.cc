@@ -129,7 +129,76 @@ std::string summary(const BenchReport& r) {
          (c.min_pair_distance_m ? fixed(*c.min_pair_distance_m, 3) + " m" : std::string("n/a")) +
          "\n";
   }
+  if (r.metrics) {
+    const nlohmann::json& m = *r.metrics;
+    auto num = [&](const nlohmann::json& v, int digits) {
+      return v.is_number() ? fixed(v.get<double>(), digits) : std::string("n/a");
+    };
+    s += "  mode " + r.mode + ", " + std::to_string(r.joints.value_or(0)) + " joints, clips:";
+    for (const std::string& c : r.clips) s += " " + c;
+    s += "\n  foot slide " + num(m["foot_slide_cm_s"], 2) + " cm/s (p95 " +
+         num(m["foot_slide_p95_cm_s"], 2) + ", clips' floor " + num(m["foot_slide_floor_cm_s"], 2) +
+         "), skate ratio " + num(m["skate_ratio"], 4) + ", drift " +
+         num(m["foot_drift_cm_per_step"], 2) + " cm/step\n";
+    s += "  torsion mean/p95/max " + num(m["torsion_deg"]["mean"], 1) + "/" +
+         num(m["torsion_deg"]["p95"], 1) + "/" + num(m["torsion_deg"]["max"], 1) +
+         " deg; facing error p95 " + num(m["facing_error_deg"]["p95"], 1) +
+         " deg; heading error p95 " + num(m["heading_error_deg"]["p95"], 1) + " deg\n";
+    s += "  root error mean/max " + num(m["root_error_cm"]["mean"], 2) + "/" +
+         num(m["root_error_cm"]["max"], 2) + " cm; playback rate " +
+         num(m["playback_rate"]["min"], 2) + ".." + num(m["playback_rate"]["max"], 2) +
+         " (outside limits " + num(m["playback_rate"]["outside_limits"], 4) + "); pops " +
+         num(m["pop_count"], 0) + "; feedback speed change " + num(m["feedback_speed_change"], 3) +
+         "\n";
+  }
   return s;
+}
+
+nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& library) {
+  using json = nlohmann::json;
+  auto or_null = [](const Summary& s, double v) { return s.count ? json(v) : json(nullptr); };
+  double floor_sum = 0.0;
+  int floor_n = 0;
+  json floors = json::object();
+  for (const LocomotionClip& c : library.clips) {
+    if (!c.gait) continue;
+    floors[c.clip.name] = c.analysis.floor.mean_cm_s;
+    floor_sum += c.analysis.floor.mean_cm_s;
+    ++floor_n;
+  }
+  const bool slid = m.slide.num_samples > 0;
+  return {
+      {"foot_slide_cm_s", slid ? json(m.slide.mean_cm_s) : json(nullptr)},
+      {"foot_slide_p95_cm_s", slid ? json(m.slide.p95_cm_s) : json(nullptr)},
+      {"skate_ratio", slid ? json(m.slide.skate_ratio) : json(nullptr)},
+      {"foot_drift_cm_per_step", slid ? json(m.slide.drift_cm_per_step) : json(nullptr)},
+      {"foot_slide_samples", m.slide.num_samples},
+      {"foot_slide_floor_cm_s", floor_n ? json(floor_sum / floor_n) : json(nullptr)},
+      {"foot_slide_floor_per_clip_cm_s", floors},
+      {"torsion_deg",
+       {{"mean", or_null(m.torsion_deg, m.torsion_deg.mean)},
+        {"p95", or_null(m.torsion_deg, m.torsion_deg.p95)},
+        {"max", or_null(m.torsion_deg, m.torsion_deg.max)}}},
+      {"facing_error_deg",
+       {{"mean", or_null(m.facing_error_deg, m.facing_error_deg.mean)},
+        {"p95", or_null(m.facing_error_deg, m.facing_error_deg.p95)}}},
+      {"heading_error_deg",
+       {{"mean", or_null(m.heading_error_deg, m.heading_error_deg.mean)},
+        {"p95", or_null(m.heading_error_deg, m.heading_error_deg.p95)}}},
+      {"root_error_cm",
+       {{"mean", or_null(m.root_error_cm, m.root_error_cm.mean)},
+        {"p95", or_null(m.root_error_cm, m.root_error_cm.p95)},
+        {"max", or_null(m.root_error_cm, m.root_error_cm.max)}}},
+      {"feedback_speed_change",
+       m.feedback_speed_change ? json(*m.feedback_speed_change) : json(nullptr)},
+      {"playback_rate",
+       {{"min", or_null(m.playback_rate, m.playback_rate.min)},
+        {"mean", or_null(m.playback_rate, m.playback_rate.mean)},
+        {"max", or_null(m.playback_rate, m.playback_rate.max)},
+        {"outside_limits", m.playback_outside_limits}}},
+      {"pop_count", m.pop_count},
+      {"max_root_jerk", m.max_root_jerk},
+  };
 }
 
 }  // namespace gk::app

@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "common/status.h"
+#include "mediator/locomotion_library.h"
+#include "mediator/metrics.h"
 
 namespace gk::app {
 
@@ -76,7 +78,7 @@ struct CrowdReport {
 struct BenchReport {
   std::string gaitkeeper_version;
   std::string scenario;
-  std::string mode = "crowd-only";  // no mediator yet; later "apm", "naive", ...
+  std::string mode = "apm";         // naive | rate | apm
   std::string sim;                  // CrowdSource::name()
   int64_t agents = 0;
   int64_t frames = 0;
@@ -92,6 +94,8 @@ struct BenchReport {
 };
 
 nlohmann::json to_json(const BenchReport& report);
+// The "metrics" object of the METRICS.md schema, plus the clips' own foot-slide floors.
+nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& library);
 Status write_report_json(const BenchReport& report, const std::string& path);
 // Human-readable summary for stdout.
 std::string summary(const BenchReport& report);

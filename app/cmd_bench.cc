@@ -12,6 +12,11 @@
 #include <CLI/CLI.hpp>
 #include <glm/geometric.hpp>
 
+#include <tbb/global_control.h>
+
+#include "animation/analysis.h"
+#include "animation/clip_library.h"
+#include "animation/procedural.h"
 #include "app/bench_report.h"
 #include "app/commands.h"
 #include "crowd/detour_crowd.h"
@@ -19,6 +24,10 @@
 #include "crowd/social_forces.h"
 #include "crowd/spatial_grid.h"
 #include "crowd/trajectory_replay.h"
+#include "mediator/joint_dump.h"
+#include "mediator/mediator.h"
+#include "mediator/metrics.h"
+#include "mediator/pose_synthesis.h"
 
 namespace gk::app {
 namespace {
@@ -33,6 +42,12 @@ struct BenchOptions {
   std::string sim = "social";
   std::string agents, frames = "600", seed = "1", threads = "1", trajectory_frame_time = "0.4";
   std::string json;
+  std::string mode = "apm";
+  std::vector<std::string> clips;
+  std::vector<std::string> sets;
+  std::string params_file;
+  std::string dump_joints;
+  std::string dump_joint_names;
 };
 
 [[noreturn]] void fail(int code, const std::string& message) {
@@ -133,6 +148,54 @@ Source make_source(const BenchOptions& o, int threads, uint64_t seed) {
   return src;
 }
 
+// The clip library: the built-in set, or the given files and folders (one clip set per file).
+LocomotionLibrary load_library(const std::vector<std::string>& clips) {
+  std::vector<ClipSet> sets;
+  if (clips.empty()) {
+    sets.push_back(make_builtin_clip_set());
+  } else {
+    auto files = expand_clip_paths(clips);
+    if (!files.ok()) fail(2, files.message());
+    if (files->empty()) fail(2, "--clips: no .bvh, .gltf or .glb file found");
+    for (const std::string& f : *files) {
+      auto set = load_clip_file(f);
+      if (!set.ok()) fail(2, set.message());
+      sets.push_back(std::move(*set));
+    }
+  }
+  auto lib = build_locomotion_library(sets);
+  if (!lib.ok()) fail(2, lib.message());
+  return std::move(*lib);
+}
+
+MediatorParams make_params(const BenchOptions& o, uint64_t seed) {
+  MediatorParams p;
+  p.seed = seed;
+  if (!o.params_file.empty()) {
+    if (Status s = load_mediator_params_json(o.params_file, &p); !s.ok()) fail(2, s.message());
+  }
+  auto mode = parse_mediator_mode(o.mode);
+  if (!mode.ok()) fail(2, "--mode: expected naive, rate or apm, got '" + o.mode + "'");
+  p.mode = *mode;
+  for (const std::string& a : o.sets) {
+    if (Status s = set_mediator_param(a, &p); !s.ok()) fail(2, s.message());
+  }
+  return p;
+}
+
+std::vector<std::string> split_names(const std::string& list) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= list.size() && !list.empty()) {
+    const size_t comma = list.find(',', start);
+    const std::string name = list.substr(start, comma == std::string::npos ? comma : comma - start);
+    if (!name.empty()) out.push_back(name);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
 void run_bench(const BenchOptions& o) {
   if (o.sim != "social" && o.sim != "detour") {
     fail(2, "--sim: expected 'social' or 'detour', got '" + o.sim + "'");
@@ -148,6 +211,23 @@ void run_bench(const BenchOptions& o) {
                  frames, kWarmupFrames);
   }
 
+  const LocomotionLibrary library = load_library(o.clips);
+  const MediatorParams params = make_params(o, seed);
+  // The mediator and pose passes run on TBB: cap its workers at --threads (0 = all cores).
+  std::optional<tbb::global_control> thread_cap;
+  if (threads > 0) thread_cap.emplace(tbb::global_control::max_allowed_parallelism, threads);
+  const size_t capacity = std::max<size_t>(crowd.capacity(), 1);
+  Mediator mediator(library, params, capacity);
+  PoseSynthesizer poses(library, capacity, /*make_palettes=*/true);
+  MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity,
+                          static_cast<size_t>(frames));
+  std::optional<JointDumpWriter> dump;
+  if (!o.dump_joints.empty()) {
+    auto opened = JointDumpWriter::open(o.dump_joints, *library.skeleton, split_names(o.dump_joint_names));
+    if (!opened.ok()) fail(2, opened.message());
+    dump.emplace(std::move(*opened));
+  }
+
   StageTimer timer(kWarmupFrames, frames);
   CrowdReport crowd_stats;
   double live_sum = 0.0, speed_sum = 0.0;
@@ -157,12 +237,23 @@ void run_bench(const BenchOptions& o) {
   for (int f = 0; f < frames; ++f) {
     const auto frame_start = StageTimer::Clock::now();
     const Status stepped = timer.time(Stage::kSim, f, [&] { return crowd.step(kFrameTime_s); });
-    // The mediator, pose and upload stages go here, each timed with timer.time(Stage::k..., f,
-    // ...).
-    timer.record(Stage::kTotal, f, StageTimer::ms_since(frame_start));
     if (!stepped.ok()) fail(1, "frame " + std::to_string(f) + ": " + stepped.message());
+    const AgentFrame frame = crowd.frame();
+    const Status planned = timer.time(Stage::kMediator, f, [&] {
+      GK_RETURN_IF_ERROR(mediator.plan(frame, static_cast<float>(kFrameTime_s)));
+      return crowd.apply_feedback(mediator.feedback().view(frame.size()));
+    });
+    if (!planned.ok()) fail(1, "frame " + std::to_string(f) + ": " + planned.message());
+    timer.time(Stage::kPose, f, [&] { poses.run(mediator, static_cast<float>(kFrameTime_s)); });
+    timer.record(Stage::kTotal, f, StageTimer::ms_since(frame_start));
 
-    const AgentFrame frame = crowd.frame();  // statistics: not part of the timed pipeline
+    // Measurement, not part of the timed pipeline.
+    metrics.record(frame, mediator, poses);
+    if (dump) {
+      if (Status s = dump->write_frame(f, (f + 1) * kFrameTime_s, frame, mediator, poses); !s.ok()) {
+        fail(1, s.message());
+      }
+    }
     live_sum += static_cast<double>(frame.size());
     crowd_stats.max_live_agents = std::max<int64_t>(crowd_stats.max_live_agents, frame.size());
     for (const glm::vec2& v : frame.velocities) {
@@ -210,6 +301,13 @@ void run_bench(const BenchOptions& o) {
     crowd_stats.removed = static_cast<int64_t>(st.removed);
   }
   report.crowd = crowd_stats;
+  report.mode = std::string(mediator_mode_name(params.mode));
+  report.joints = library.skeleton->num_joints();
+  report.clips = library.clip_names();
+  report.metrics = metrics_to_json(metrics.finish(), library);
+  if (dump) {
+    if (Status s = dump->close(); !s.ok()) fail(1, s.message());
+  }
   std::fputs(summary(report).c_str(), stdout);
   if (!o.json.empty()) {
     if (const Status written = write_report_json(report, o.json); !written.ok()) {
@@ -224,7 +322,9 @@ void run_bench(const BenchOptions& o) {
 void add_bench_command(CLI::App& app) {
   auto options = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "bench", "Run a crowd headless at 60 Hz and report stage timings and crowd statistics.");
+      "bench",
+      "Run a crowd and the mediator headless at 60 Hz; report stage timings, crowd statistics and "
+      "the animation metrics of METRICS.md.");
   cmd->add_option(
          "--scenario", options->scenario,
          "Scenario name (data/scenarios, or $GAITKEEPER_SCENARIOS), a scenario .json file, "
@@ -243,6 +343,18 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--trajectory-frame-time", options->trajectory_frame_time,
                   "Seconds between two samples of a replayed trajectory (default 0.4)");
   cmd->add_option("--json", options->json, "Write the report (METRICS.md schema) to this file");
+  cmd->add_option("--mode", options->mode,
+                  "naive (nearest clip at native rate), rate (speed-matched playback only) or "
+                  "apm (the whole mediator; default)");
+  cmd->add_option("--clips", options->clips,
+                  "BVH/glTF/GLB files or folders forming the clip library (default: built-in)");
+  cmd->add_option("--set", options->sets,
+                  "Mediator parameter, e.g. --set torsion_limit_deg=40 (repeatable)");
+  cmd->add_option("--params", options->params_file, "JSON file of mediator parameters");
+  cmd->add_option("--dump-joints", options->dump_joints,
+                  "Write world joint positions per frame and agent to this CSV");
+  cmd->add_option("--dump-joint-names", options->dump_joint_names,
+                  "Comma-separated joints to dump (default: left/right ankle and toe)");
   cmd->callback([options] { run_bench(*options); });
 }
 
