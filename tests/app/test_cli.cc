@@ -1,0 +1,202 @@
+// The gaitkeeper executable end to end: analyze-clip over the real clips, bench reports, and the
+// METRICS.md rule that a metric recomputed from the --dump-joints CSV equals the JSON's.
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/test_data.h"
+
+namespace gk {
+namespace {
+
+struct CommandResult {
+  int code = -1;
+  std::string out;  // stdout and stderr
+};
+
+CommandResult run(const std::string& args) {
+  CommandResult r;
+  const std::string cmd = std::string(GK_GAITKEEPER_BIN) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST(Cli, AnalyzeClipCoversEverySharedClip) {
+  GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
+  const std::string out = test::scratch_dir("cli") + "/analysis.json";
+  const CommandResult r = run("analyze-clip --json " + test::data_path("clips/bvh") + " " +
+                    test::data_path("clips/gltf/ual_mannequin_quaternius.glb") + " > " + out);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json all = read_json(out);
+  // 8 BVH clips + 44 glb animations (PROVENANCE.md).
+  ASSERT_EQ(all.size(), 52u);
+  std::map<std::string, nlohmann::json> by_name;
+  for (const auto& c : all) {
+    for (const char* field : {"name", "frames", "fps", "duration_s", "joints", "scale",
+                              "native_speed_m_s", "direction_deg", "cycle", "contacts",
+                              "foot_slide_floor_cm_s"}) {
+      EXPECT_TRUE(c.contains(field)) << field;
+    }
+    by_name[c["name"].get<std::string>()] = c;
+  }
+  EXPECT_NEAR(by_name["cmu_07_01_walk"]["native_speed_m_s"].get<double>(), 1.36, 0.068);
+  EXPECT_NEAR(by_name["cmu_09_11_run"]["native_speed_m_s"].get<double>(), 3.50, 0.175);
+  EXPECT_NEAR(by_name["cmu_07_01_walk"]["scale"].get<double>(), 0.056444, 1e-6);
+  EXPECT_EQ(by_name["cmu_07_01_walk"]["frames"].get<int>(), 316);
+  EXPECT_EQ(by_name["Walk_Loop"]["joints"].get<int>(), 53);
+}
+
+TEST(Cli, AnalyzeClipNamesTheBrokenFile) {
+  const std::string bad = test::source_path("tests/data/bad/channel_count.bvh");
+  const CommandResult r = run("analyze-clip " + bad);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("channel_count.bvh:"), std::string::npos) << r.out;
+}
+
+// Foot slide recomputed from the CSV with the METRICS.md definitions, independently of the code.
+struct Slide {
+  double mean = 0.0, skate = 0.0, drift = 0.0;
+  size_t samples = 0;
+};
+
+Slide slide_from_csv(const std::string& path, const std::string& toe_l, const std::string& ankle_l,
+                     const std::string& toe_r, const std::string& ankle_r, double dt) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "frame,time_s,agent,joint,x,y,z");
+  // agent -> joint -> frame -> position
+  std::map<int, std::map<std::string, std::map<int, glm::vec3>>> data;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string f, t, a, j, x, y, z;
+    std::getline(ss, f, ',');
+    std::getline(ss, t, ',');
+    std::getline(ss, a, ',');
+    std::getline(ss, j, ',');
+    std::getline(ss, x, ',');
+    std::getline(ss, y, ',');
+    std::getline(ss, z, ',');
+    data[std::stoi(a)][j][std::stoi(f)] = glm::vec3(std::stof(x), std::stof(y), std::stof(z));
+  }
+  std::vector<double> speeds;
+  double drift_sum = 0.0;
+  int intervals = 0;
+  for (auto& [agent, joints] : data) {
+    for (auto [toe_name, ankle_name] : {std::pair{toe_l, ankle_l}, std::pair{toe_r, ankle_r}}) {
+      auto& toe = joints[toe_name];
+      auto& ankle = joints[ankle_name];
+      float min_t = 1e9f, min_a = 1e9f;
+      for (auto& [f, p] : toe) min_t = std::min(min_t, p.y);
+      for (auto& [f, p] : ankle) min_a = std::min(min_a, p.y);
+      std::vector<int> frames;
+      for (auto& [f, p] : toe) frames.push_back(f);
+      std::vector<bool> contact(frames.size());
+      for (size_t k = 0; k < frames.size(); ++k) {
+        contact[k] = toe[frames[k]].y <= min_t + 0.025f && ankle[frames[k]].y <= min_a + 0.05f;
+      }
+      size_t run_start = 0;
+      for (size_t k = 0; k < frames.size(); ++k) {
+        const glm::vec3 p = toe[frames[k]];
+        if (contact[k] && (k == 0 || !contact[k - 1])) run_start = k;
+        if (k > 0 && contact[k] && contact[k - 1]) {
+          const glm::vec3 q = toe[frames[k - 1]];
+          speeds.push_back(100.0 * std::hypot(double(p.x) - q.x, double(p.z) - q.z) / dt);
+        }
+        const bool ends = contact[k] && (k + 1 == frames.size() || !contact[k + 1]);
+        if (ends && k > run_start) {
+          const glm::vec3 s = toe[frames[run_start]];
+          drift_sum += 100.0 * std::hypot(double(p.x) - s.x, double(p.z) - s.z);
+          ++intervals;
+        }
+      }
+    }
+  }
+  Slide out;
+  out.samples = speeds.size();
+  for (double v : speeds) {
+    out.mean += v;
+    out.skate += v > 30.0;
+  }
+  if (!speeds.empty()) {
+    out.mean /= speeds.size();
+    out.skate /= speeds.size();
+  }
+  if (intervals) out.drift = drift_sum / intervals;
+  return out;
+}
+
+TEST(Cli, MetricRecomputedFromTheJointDumpEqualsTheReport) {
+  const std::string dir = test::scratch_dir("cli");
+  const std::string csv = dir + "/joints.csv", json = dir + "/report.json";
+  const CommandResult r = run("bench --scenario crossing --agents 16 --frames 240 --mode apm --json " + json +
+                    " --dump-joints " + csv);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json rep = read_json(json);
+  const auto& m = rep["metrics"];
+  // The built-in skeleton's feet: CMU-style names.
+  const Slide s = slide_from_csv(csv, "LeftToeBase", "LeftFoot", "RightToeBase", "RightFoot",
+                                 rep["frame_time_s"].get<double>());
+  ASSERT_GT(s.samples, 100u);
+  EXPECT_EQ(static_cast<int64_t>(s.samples), m["foot_slide_samples"].get<int64_t>());
+  EXPECT_NEAR(s.mean, m["foot_slide_cm_s"].get<double>(), 1e-3 * s.mean + 1e-6);
+  EXPECT_NEAR(s.skate, m["skate_ratio"].get<double>(), 1e-6);
+  EXPECT_NEAR(s.drift, m["foot_drift_cm_per_step"].get<double>(), 1e-3 * s.drift + 1e-6);
+  // Headless: no upload or render stage, and they are null, not 0.
+  EXPECT_TRUE(rep["timing_ms"]["render"].is_null());
+  EXPECT_TRUE(rep["timing_ms"]["upload"].is_null());
+  EXPECT_TRUE(rep["timing_ms"]["pose"]["median"].is_number());
+  EXPECT_EQ(rep["joints"].get<int>(), 25);
+}
+
+TEST(Cli, BenchReplaysRealTrajectories) {
+  GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
+  const std::string json = test::scratch_dir("cli") + "/zara.json";
+  const CommandResult r = run("bench --scenario " + test::data_path("trajectories/zara1/crowds_zara01.txt") +
+                    " --frames 300 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json rep = read_json(json);
+  EXPECT_GT(rep["crowd"]["max_live_agents"].get<int>(), 0);
+  // The data is the truth: no feedback, so the rendered root only sways about p.
+  EXPECT_TRUE(rep["metrics"]["feedback_speed_change"].is_null());
+  EXPECT_LT(rep["metrics"]["root_error_cm"]["mean"].get<double>(), 10.0);
+}
+
+TEST(Cli, BadParametersAreRefusedWithTheirLimits) {
+  CommandResult r = run("bench --scenario corridor --frames 10 --set torsion_limit_deg=400");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("torsion_limit_deg"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0..90"), std::string::npos) << r.out;
+  r = run("bench --scenario corridor --frames 10 --set no_such_thing=1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("unknown parameter"), std::string::npos) << r.out;
+  r = run("bench --scenario corridor --frames 10 --mode skate");
+  EXPECT_EQ(r.code, 2);
+  r = run("bench --scenario corridor --frames 10 --clips /no/such/file.bvh");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("/no/such/file.bvh"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace gk
