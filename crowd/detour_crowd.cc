@@ -79,7 +79,9 @@ class DetourCrowdSource final : public CrowdSource {
  public:
   std::string name() const override { return name_; }
   Status step(float dt_s) override;
-  AgentFrame frame() const override { return AgentFrame{ids_, positions_, velocities_, thetas_}; }
+  AgentFrame frame() const override {
+    return AgentFrame{live_ids_, live_positions_, live_velocities_, live_thetas_};
+  }
   FeedbackPolicy feedback_policy() const override { return FeedbackPolicy::kHonoured; }
   Status apply_feedback(const AgentFeedback& feedback) override;
   double time_s() const override { return time_s_; }
@@ -90,6 +92,7 @@ class DetourCrowdSource final : public CrowdSource {
  private:
   void advance_waypoints();
   void request_target(size_t i);
+  void gather_live();
 
   std::string name_;
   // Destroyed in reverse order: the crowd and the query refer to the navmesh.
@@ -102,6 +105,14 @@ class DetourCrowdSource final : public CrowdSource {
   std::vector<float> thetas_;
   std::vector<uint32_t> waypoint_begin_, waypoint_end_, waypoint_current_;
   std::vector<uint8_t> loop_;
+  std::vector<uint8_t> remove_at_goal_;  // vanish at the end of a non-looping chain
+  std::vector<float> goal_radius_;       // final waypoint reached within this distance [m]
+  std::vector<uint8_t> alive_;
+  // The frame: live agents only, compacted (frame index k is dtCrowd agent live_agent_[k]).
+  std::vector<uint32_t> live_ids_;
+  std::vector<glm::vec2> live_positions_, live_velocities_;
+  std::vector<float> live_thetas_;
+  std::vector<uint32_t> live_agent_;
   // Waypoints snapped onto the navmesh: (x, y, z) and their polygons.
   std::vector<float> waypoint_pos_;
   std::vector<dtPolyRef> waypoint_ref_;
@@ -193,7 +204,19 @@ Status DetourCrowdSource::init(const Scenario& scenario, const ScenarioAgents& a
   waypoint_end_.resize(n);
   waypoint_current_.resize(n);
   loop_.resize(n);
+  alive_.assign(n, 1);
+  remove_at_goal_.assign(n, 0);
+  goal_radius_.assign(n, kWaypointReached_m);
+  live_ids_.reserve(n);
+  live_positions_.reserve(n);
+  live_velocities_.reserve(n);
+  live_thetas_.reserve(n);
+  live_agent_.reserve(n);
   for (size_t i = 0; i < n; ++i) {
+    if (!agents.remove_at_goal.empty()) remove_at_goal_[i] = agents.remove_at_goal[i];
+    if (!agents.goal_radii_m.empty() && agents.goal_radii_m[i] > 0.0f) {
+      goal_radius_[i] = agents.goal_radii_m[i];
+    }
     float start[3];
     if (snap_to_navmesh(*query_, filter, agents.positions[i], kStartSnap_m, start) == 0) {
       return Status::AtField(file, field("positions", i),
@@ -233,6 +256,7 @@ Status DetourCrowdSource::init(const Scenario& scenario, const ScenarioAgents& a
   }
   // Detour has no randomness: the seed is not needed for reproducible runs.
   (void)params.seed;
+  gather_live();
   return Status::Ok();
 }
 
@@ -246,11 +270,22 @@ void DetourCrowdSource::request_target(size_t i) {
 void DetourCrowdSource::advance_waypoints() {
   for (size_t i = 0; i < ids_.size(); ++i) {
     const uint32_t begin = waypoint_begin_[i], end = waypoint_end_[i];
-    if (begin == end) continue;
+    if (begin == end || !alive_[i]) continue;
     const uint32_t w = waypoint_current_[i];
     const bool is_last = w + 1 == end;
-    if (is_last && !loop_[i]) continue;
     const dtCrowdAgent* ag = crowd_->getAgent(static_cast<int>(i));
+    if (is_last && !loop_[i]) {
+      // The end of the chain: agents that leave the scene (an exit) vanish there.
+      const float* goal = &waypoint_pos_[3 * w];
+      const float gx = ag->npos[0] - goal[0], gz = ag->npos[2] - goal[2];
+      // At least kWaypointReached_m: a crowd cannot all reach one point, the last ones would pile up.
+      const float r = std::max(goal_radius_[i], kWaypointReached_m);
+      if (remove_at_goal_[i] && gx * gx + gz * gz <= r * r) {
+        crowd_->removeAgent(static_cast<int>(i));
+        alive_[i] = 0;
+      }
+      continue;
+    }
     const float* target = ag->partial ? ag->corridor.getTarget() : &waypoint_pos_[3 * w];
     const float dx = ag->npos[0] - target[0], dz = ag->npos[2] - target[2];
     if (dx * dx + dz * dz > kWaypointReached_m * kWaypointReached_m) continue;
@@ -275,6 +310,7 @@ Status DetourCrowdSource::step(float dt_s) {
 
   const float blend = 1.0f - std::exp(-dt_s / kThetaTau_s);
   for (size_t i = 0; i < ids_.size(); ++i) {
+    if (!alive_[i]) continue;
     const dtCrowdAgent* ag = crowd_->getAgent(static_cast<int>(i));
     const glm::vec2 p(ag->npos[0], ag->npos[2]), v(ag->vel[0], ag->vel[2]);
     if (!finite2(p) || !finite2(v)) {
@@ -287,11 +323,28 @@ Status DetourCrowdSource::step(float dt_s) {
       thetas_[i] = wrap_angle(thetas_[i] + wrap_angle(heading_of(v) - thetas_[i]) * blend);
     }
   }
+  gather_live();
   return Status::Ok();
 }
 
+void DetourCrowdSource::gather_live() {
+  live_ids_.clear();
+  live_positions_.clear();
+  live_velocities_.clear();
+  live_thetas_.clear();
+  live_agent_.clear();
+  for (size_t i = 0; i < ids_.size(); ++i) {
+    if (!alive_[i]) continue;
+    live_ids_.push_back(ids_[i]);
+    live_positions_.push_back(positions_[i]);
+    live_velocities_.push_back(velocities_[i]);
+    live_thetas_.push_back(thetas_[i]);
+    live_agent_.push_back(static_cast<uint32_t>(i));
+  }
+}
+
 Status DetourCrowdSource::apply_feedback(const AgentFeedback& fb) {
-  const size_t n = ids_.size();
+  const size_t n = live_ids_.size();
   if (fb.has_feedback.size() != n || fb.positions.size() != n || fb.velocities.size() != n ||
       fb.thetas.size() != n) {
     return Status::Error(name_ + ": apply_feedback: expected " + std::to_string(n) +
@@ -306,26 +359,28 @@ Status DetourCrowdSource::apply_feedback(const AgentFeedback& fb) {
     }
   }
   const dtQueryFilter* filter = crowd_->getFilter(0);
-  for (size_t i = 0; i < n; ++i) {
-    if (!fb.has_feedback[i]) continue;
+  for (size_t k = 0; k < n; ++k) {
+    if (!fb.has_feedback[k]) continue;
+    const size_t i = live_agent_[k];
     dtCrowdAgent* ag = crowd_->getEditableAgent(static_cast<int>(i));
     if (!ag->active || ag->state != DT_CROWDAGENT_STATE_WALKING) continue;
     // Slide along the navmesh toward the requested position (as Detour's own integration does),
     // so feedback can never put an agent inside a wall or off the mesh.
-    const float target[3] = {fb.positions[i].x, ag->npos[1], fb.positions[i].y};
+    const float target[3] = {fb.positions[k].x, ag->npos[1], fb.positions[k].y};
     if (ag->corridor.movePosition(target, query_.get(), filter)) {
       const float* pos = ag->corridor.getPos();
       ag->npos[0] = pos[0];
       ag->npos[1] = pos[1];
       ag->npos[2] = pos[2];
     }
-    ag->vel[0] = fb.velocities[i].x;
+    ag->vel[0] = fb.velocities[k].x;
     ag->vel[1] = 0.0f;
-    ag->vel[2] = fb.velocities[i].y;
+    ag->vel[2] = fb.velocities[k].y;
     positions_[i] = glm::vec2(ag->npos[0], ag->npos[2]);
-    velocities_[i] = fb.velocities[i];
-    thetas_[i] = wrap_angle(fb.thetas[i]);
+    velocities_[i] = fb.velocities[k];
+    thetas_[i] = wrap_angle(fb.thetas[k]);
   }
+  gather_live();
   return Status::Ok();
 }
 
