@@ -256,6 +256,30 @@ TEST(DetourCrowd, LoopingWaypointChain) {
   EXPECT_GE(visits, 3);
 }
 
+TEST(DetourCrowd, AgentsLeavingAtTheirGoalVanishFromTheFrame) {
+  // Two walkers: one leaves the scene at its goal, one stays there; ids stay stable.
+  ScenarioAgents agents;
+  add_agent(&agents, {-8.0f, -1.0f}, 1.4f, 0.3f, {{-5.0f, -1.0f}});
+  add_agent(&agents, {-8.0f, 1.0f}, 1.4f, 0.3f, {{-5.0f, 1.0f}});
+  agents.remove_at_goal = {1, 0};
+  agents.goal_radii_m = {0.5f, 0.5f};
+  auto crowd = make(corridor(), agents);
+  ASSERT_TRUE(crowd);
+  ASSERT_EQ(crowd->frame().size(), 2u);
+  for (int step = 0; step < 60 * 10; ++step) ASSERT_TRUE(crowd->step(kDt).ok());
+  // 3 m at 1.4 m/s takes about 2 s: after 10 s the first has gone, the second stands at its goal.
+  const AgentFrame f = crowd->frame();
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f.ids[0], 1u);
+  EXPECT_LT(glm::length(f.positions[0] - glm::vec2(-5.0f, 1.0f)), 1.0f);
+  // Feedback is index-aligned with the (shorter) frame.
+  const uint8_t has[1] = {1};
+  const glm::vec2 pos[1] = {f.positions[0]}, vel[1] = {{0.0f, 0.0f}};
+  const float th[1] = {0.5f};
+  EXPECT_TRUE(crowd->apply_feedback({has, pos, vel, th}).ok());
+  EXPECT_FLOAT_EQ(crowd->frame().thetas[0], 0.5f);
+}
+
 // Every shipped scenario (loaded, scaled and expanded by the scenario module) runs on Detour:
 // walls are never crossed, speeds stay within each agent's maximum and the crowd gets going.
 TEST(DetourCrowd, RunsEveryScenarioFile) {
