@@ -183,6 +183,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
       min_a = std::min(min_a, ankle[s][f].y);
     }
     lc->toe_floor_m[s] = min_t;
+    lc->ankle_floor_m[s] = min_a;
     std::vector<uint8_t> analysed(n, 0);
     for (const TimeInterval& iv : lc->analysis.contacts[s]) {
       const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
@@ -405,8 +406,11 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   lib.idle = static_cast<int>(lib.clips.size()) - 1;
   for (int s = 0; s < 2; ++s) {
     lib.toe_floor_m[s] = 1e9f;
+    lib.ankle_floor_m[s] = 1e9f;
     for (const LocomotionClip& c : lib.clips) {
-      if (c.gait) lib.toe_floor_m[s] = std::min(lib.toe_floor_m[s], c.toe_floor_m[s]);
+      if (!c.gait) continue;
+      lib.toe_floor_m[s] = std::min(lib.toe_floor_m[s], c.toe_floor_m[s]);
+      lib.ankle_floor_m[s] = std::min(lib.ankle_floor_m[s], c.ankle_floor_m[s]);
     }
   }
   for (const LocomotionClip& c : lib.clips) {

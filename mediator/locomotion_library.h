@@ -34,7 +34,8 @@ struct LocomotionClip {
   std::vector<uint8_t> plant[2];
   std::vector<uint8_t> hold[2];
   std::vector<float> toe_height_m[2];  // toe height above its lowest point
-  float toe_floor_m[2] = {0.0f, 0.0f};  // lowest toe height in the clip
+  float toe_floor_m[2] = {0.0f, 0.0f};    // lowest toe height in the clip
+  float ankle_floor_m[2] = {0.0f, 0.0f};  // lowest ankle height in the clip
   float time_at_phase(float phase) const;  // phase in [0, 1)
 };
 
@@ -56,6 +57,7 @@ struct LocomotionLibrary {
   // Height of each toe joint when the foot is flat on the ground [m] (lowest over the gait clips):
   // planted feet are locked at this height.
   float toe_floor_m[2] = {0.0f, 0.0f};
+  float ankle_floor_m[2] = {0.0f, 0.0f};  // likewise for the ankle joints
   // Largest per-frame change of any joint's local rotation over all source clips, resampled to
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;

@@ -349,12 +349,16 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   }
   idle_time_[slot] += dt;
   // Clip times at the shared gait phase (phase-synchronised blending; a new clip starts in phase).
-  float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f};
+  // Foot flags are voted by the gait clips alone once they carry a quarter of the blend: a standing
+  // clip's "both feet down" would otherwise keep a stepping foot locked while it swings.
+  float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
+  const bool gait_votes = gait_w >= 0.25f;
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     const LocomotionClip& clip = lib.clips[lc[k]];
     lt[k] = clip.gait ? clip.time_at_phase(phase_[slot])
                       : std::fmod(idle_time_[slot], std::max(clip.clip.duration_s(), 1e-3f));
-    if (lw[k] <= 0.0f) continue;
+    if (lw[k] <= 0.0f || (gait_votes && !clip.gait)) continue;
+    vote_w += lw[k];
     const int nf = clip.clip.num_frames;
     int f = static_cast<int>(std::lround(lt[k] * clip.clip.fps));
     f = clip.clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
@@ -362,6 +366,10 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
       plant[s] += lw[k] * clip.plant[s][f];
       hold[s] += lw[k] * clip.hold[s][f];
     }
+  }
+  for (int s = 0; s < 2; ++s) {
+    plant[s] /= std::max(vote_w, 1e-6f);
+    hold[s] /= std::max(vote_w, 1e-6f);
   }
   // 8. Feedback: the speed and torso orientation the animation can deliver.
   const int a = agent;

@@ -28,6 +28,21 @@ glm::quat rotation_of(const glm::mat4& m) {
   return glm::normalize(glm::quat_cast(glm::mat3(m)));
 }
 
+// Highest lift [m] of a released foot on its way back to the clip's foot.
+constexpr float kReleaseLiftMax = 0.05f;
+// A foot plants when its toe is within kPlantToe and its ankle within kPlantAnkle of the ground
+// (METRICS.md counts 2.5 cm and 5 cm as contact) and it moves slower than kPlantSpeed over it.
+constexpr float kPlantToe = 0.03f;
+constexpr float kPlantAnkle = 0.06f;
+constexpr float kPlantSpeed = 0.5f;  // [m/s]
+// A planted foot is held until its toe or ankle clearly lifts (heel-off pivots on the ball).
+constexpr float kHoldToe = 0.045f;
+constexpr float kHoldAnkle = 0.09f;
+// A free foot moving faster than kPlantSpeed low over the ground is lifted to this clearance so it
+// swings instead of dragging; fully from kClearSpeed on.
+constexpr float kClearance = 0.035f;
+constexpr float kClearSpeed = 0.9f;  // [m/s]
+
 float smoothstep01(float x) {
   x = std::clamp(x, 0.0f, 1.0f);
   return x * x * (3.0f - 2.0f * x);
@@ -72,6 +87,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.from.assign(capacity * 2, glm::vec3(0.0f));
   locks_.weight.assign(capacity * 2, 0.0f);
   locks_.timer.assign(capacity * 2, 0.0f);
+  locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
   first_spine_joint_ = skeleton_.spine_chain.empty() ? num_joints_ : skeleton_.spine_chain.front();
 }
@@ -187,8 +203,16 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     const glm::vec3 anim_toe = translation_of(world_[base + toe]);
     const glm::vec3 anim_ankle = translation_of(world_[base + ankle]);
-    const bool planted = pl.plant[side][slot] > 0.5f;
-    const bool held = pl.hold[side][slot] > 0.5f;
+    // Contact from the animated foot itself (after blending, placing and twisting), not from the
+    // clips' labels: a blend of a standing and a walking clip has feet of its own.
+    const float toe_h = anim_toe.y - library_.toe_floor_m[side];
+    const float ankle_h = anim_ankle.y - library_.ankle_floor_m[side];
+    const glm::vec3 prev = locks_.anim_toe[k];
+    locks_.anim_toe[k] = anim_toe;
+    const float ground_speed =
+        pl.fresh[slot] ? 0.0f : std::hypot(anim_toe.x - prev.x, anim_toe.z - prev.z) / dt;
+    const bool planted = toe_h <= kPlantToe && ankle_h <= kPlantAnkle && ground_speed < kPlantSpeed;
+    const bool held = toe_h <= kHoldToe && ankle_h <= kHoldAnkle;
     auto& state = reinterpret_cast<FootLockState&>(locks_.state[k]);
     float& weight = locks_.weight[k];
     glm::vec3& target = locks_.target[k];
@@ -196,45 +220,58 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
       state = FootLockState::kFree;
       weight = 0.0f;
     }
-    const glm::vec3 current = glm::mix(anim_toe, target, weight);  // where the toe is drawn now
     switch (state) {
       case FootLockState::kFree:
         if (planted) {
           state = FootLockState::kLocked;
           target = anim_toe;
-          target.y = std::min(anim_toe.y, library_.toe_floor_m[side]);  // flat on the ground
           weight = 1.0f;
         }
         break;
       case FootLockState::kLocked: {
         if (!held) {
           state = FootLockState::kReleasing;
+          locks_.from[k] = target;
+          locks_.timer[k] = 0.0f;
           break;
         }
+        // The pinned toe follows the clip's toe down (a heel strike rolls onto the ball), never up.
+        target.y = std::min(target.y, anim_toe.y);
         // Standing: a foot left behind by a turn or a drift is re-planted with a short step,
         // one foot at a time.
         const glm::vec3 d = target - anim_toe;
         const float drift = std::hypot(d.x, d.z);
         const size_t other = static_cast<size_t>(slot) * 2 + (1 - side);
-        if (pl.standing[slot] && drift > P.idle_step_distance_m &&
-            locks_.state[other] == static_cast<uint8_t>(FootLockState::kLocked)) {
-          state = FootLockState::kStepping;
-          locks_.from[k] = target;
-          locks_.timer[k] = 0.0f;
+        if (drift > P.idle_step_distance_m) {
+          if (!pl.standing[slot]) {  // walking slowly with feet that hardly lift: step anyway
+            state = FootLockState::kReleasing;
+            locks_.from[k] = target;
+            locks_.timer[k] = 0.0f;
+          } else if (locks_.state[other] == static_cast<uint8_t>(FootLockState::kLocked)) {
+            state = FootLockState::kStepping;
+            locks_.from[k] = target;
+            locks_.timer[k] = 0.0f;
+          }
         }
         break;
       }
-      case FootLockState::kReleasing:
-        weight = std::max(0.0f, weight - dt / P.lock_release_s);
-        if (planted) {
-          // Re-plant where the toe is drawn now, so nothing jumps.
-          state = FootLockState::kLocked;
-          target = current;
-          weight = 1.0f;
-        } else if (weight <= 0.0f) {
+      case FootLockState::kReleasing: {
+        // The foot is carried from where it was pinned to where the clip has it: lifted first,
+        // then moved, so a released foot steps instead of sliding over the ground.
+        locks_.timer[k] += dt;
+        const float u = std::min(1.0f, locks_.timer[k] / P.lock_release_s);
+        const glm::vec3 from = locks_.from[k];
+        const float gap = std::hypot(anim_toe.x - from.x, anim_toe.z - from.z);
+        const float lift = std::min(kReleaseLiftMax, 5.0f * gap) *
+                           std::sqrt(std::max(0.0f, std::sin(3.14159265f * u)));
+        target = glm::mix(from, anim_toe, smoothstep01(u)) + glm::vec3(0.0f, lift, 0.0f);
+        weight = 1.0f;
+        if (u >= 1.0f) {
           state = FootLockState::kFree;
+          weight = 0.0f;
         }
         break;
+      }
       case FootLockState::kStepping: {
         locks_.timer[k] += dt;
         const float u = locks_.timer[k] / P.idle_step_time_s;
@@ -250,14 +287,22 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
       }
     }
     ankle_world_rot[side] = rotation_of(world_[base + ankle]);
-    if (weight <= 0.0f) continue;
+    // A free foot skimming the ground fast is lifted clear (continuous in height and speed).
+    float lift = 0.0f;
+    if (state == FootLockState::kFree && ankle_h <= kHoldAnkle) {
+      const float fast = smoothstep01((ground_speed - kPlantSpeed) / (kClearSpeed - kPlantSpeed));
+      lift = std::max(0.0f, kClearance - toe_h) * fast;
+    }
+    if (weight <= 0.0f && lift <= 0.0f) continue;
     // IK: move the ankle by the toe's offset, keep the foot's world orientation.
-    const glm::vec3 goal_toe = glm::mix(anim_toe, target, weight);
+    const glm::vec3 goal_toe = glm::mix(anim_toe, target, weight) + glm::vec3(0.0f, lift, 0.0f);
     const glm::vec3 goal_ankle = anim_ankle + (goal_toe - anim_toe);
     const glm::vec3 hip_p = translation_of(world_[base + hip]);
     const float reach = glm::length(goal_ankle - hip_p);
     if (reach > P.max_leg_stretch * library_.leg_length_m[side] && state == FootLockState::kLocked) {
       state = FootLockState::kReleasing;  // overstretched: let the foot go, smoothly
+      locks_.from[k] = target;
+      locks_.timer[k] = 0.0f;
     }
     const glm::vec3 knee_p = translation_of(world_[base + knee]);
     const glm::vec3 axis = glm::normalize(anim_ankle - hip_p);

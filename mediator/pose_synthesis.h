@@ -24,6 +24,7 @@ struct FootLocks {
   std::vector<glm::vec3> from;     // stepping: where the step started
   std::vector<float> weight;       // IK weight 0..1
   std::vector<float> timer;        // stepping progress [s]
+  std::vector<glm::vec3> anim_toe; // the clip's (unlocked) toe position last frame
 };
 
 class PoseSynthesizer {
