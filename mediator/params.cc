@@ -39,8 +39,6 @@ constexpr ParamInfo kInfos[] = {
      K::kFloat, &P::max_leg_stretch},
     {"idle_step_distance_m", "m", "standing: foot drift that makes the agent re-plant it", 0.02f, 0.5f,
      K::kFloat, &P::idle_step_distance_m},
-    {"idle_step_angle_deg", "deg", "standing: pelvis-to-foot yaw that makes the agent step", 5.0f,
-     90.0f, K::kFloat, &P::idle_step_angle_deg},
     {"idle_step_time_s", "s", "duration of a re-planting step while standing or turning", 0.1f, 1.0f,
      K::kFloat, &P::idle_step_time_s},
     {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator", 0.0f,

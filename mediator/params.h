@@ -38,7 +38,6 @@ struct MediatorParams {
   float lock_release_s = 0.12f;       // [s] [Limit: 0.02..0.5] blend-out time of a released lock
   float max_leg_stretch = 0.995f;     // [ratio of leg length] [Limit: 0.9..1] locks beyond release
   float idle_step_distance_m = 0.12f; // [m] [Limit: 0.02..0.5] planted-foot drift that triggers a step
-  float idle_step_angle_deg = 30.0f;  // [deg] [Limit: 5..90] pelvis-foot yaw that triggers a step
   float idle_step_time_s = 0.35f;     // [s] [Limit: 0.1..1] duration of a re-planting step
   // 8. Feedback to the simulator.
   bool feedback = true;
