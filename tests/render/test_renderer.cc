@@ -1,0 +1,336 @@
+// Offscreen rendering of small crowds with known placements and palettes, checked pixel by pixel
+// against a frame of the same scene without agents.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <vector>
+
+#include <stb_image.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "animation/pose_jobs.h"
+#include "animation/procedural.h"
+#include "tests/render/render_test_support.h"
+
+namespace gk::test {
+namespace {
+
+constexpr float kPi = 3.14159265f;
+
+// The crowd's body: the procedural mannequin in a walking pose, its palettes computed on the CPU
+// exactly as the app will.
+struct CrowdModel {
+  SkinnedMesh mesh;
+  int joints_per_agent = 2;
+  float mid_height_m = 1.0f;  // a point inside the body to project
+  float half_width_m = 0.5f;  // generous horizontal bound of the posed body and its shadow
+  float height_m = 2.0f;
+  ClipSet clip_set;
+  const Clip* clip = nullptr;
+
+  void palette(const glm::vec3& position, float heading_rad, float time_s,
+               std::span<glm::mat4> out) const;
+};
+
+CrowdModel make_crowd_model() {
+  CrowdModel model;
+  model.clip_set = make_builtin_clip_set();
+  const Skeleton& skeleton = *model.clip_set.skeleton;
+  model.mesh = model.clip_set.mesh ? *model.clip_set.mesh : *make_mannequin_mesh(skeleton);
+  model.joints_per_agent = skeleton.num_joints();
+  for (const Clip& c : model.clip_set.clips) {
+    if (c.name.find("walk") != std::string::npos) {
+      model.clip = &c;
+      break;
+    }
+  }
+  if (model.clip == nullptr && !model.clip_set.clips.empty()) model.clip = &model.clip_set.clips[0];
+  model.mid_height_m = 1.1f;  // chest height of a 1.75 m humanoid
+  model.half_width_m = 1.0f;
+  model.height_m = 2.0f;
+  return model;
+}
+
+void CrowdModel::palette(const glm::vec3& position, float heading_rad, float time_s,
+                         std::span<glm::mat4> out) const {
+  const Skeleton& skeleton = *clip_set.skeleton;
+  const int n = skeleton.num_joints();
+  std::vector<glm::quat> rotations(skeleton.rest_rotations);
+  std::vector<glm::vec3> translations(skeleton.rest_translations);
+  if (clip != nullptr) {
+    SampleClipJob sample{clip, time_s, rotations, translations};
+    if (sample.validate()) sample.run();
+    // Keep the agent where the test placed it: drop the clip's horizontal root motion.
+    translations[0].x = 0.0f;
+    translations[0].z = 0.0f;
+  }
+  std::vector<glm::mat4> model(n);
+  LocalToModelJob fk;
+  fk.skeleton = &skeleton;
+  fk.rotations = rotations;
+  fk.translations = translations;
+  fk.root_transform = glm::rotate(glm::translate(glm::mat4(1.0f), position), heading_rad,
+                                  glm::vec3(0.0f, 1.0f, 0.0f));
+  fk.out_model = model;
+  ASSERT_TRUE(fk.validate());
+  fk.run();
+  SkinningPaletteJob skin{model, mesh.inverse_bind, out.first(n)};
+  ASSERT_TRUE(skin.validate());
+  skin.run();
+}
+
+// Screen rectangle [min, max] covering an axis-aligned world box, or an empty one if any corner is
+// behind the camera (the tests keep every agent in front).
+void screen_bounds(const OrbitCamera& camera, glm::ivec2 viewport, const glm::vec3& lo,
+                   const glm::vec3& hi, glm::vec2* out_min, glm::vec2* out_max) {
+  *out_min = glm::vec2(1e9f);
+  *out_max = glm::vec2(-1e9f);
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 p((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+    const ProjectedPoint q = camera.project(p, viewport);
+    if (!q.in_front) continue;
+    *out_min = glm::min(*out_min, q.pixel);
+    *out_max = glm::max(*out_max, q.pixel);
+  }
+}
+
+class RendererTest : public OffscreenRenderTest {};
+
+TEST_F(RendererTest, CrowdIsDrawnWhereProjectedAndNowhereElse) {
+  const CrowdModel model = make_crowd_model();
+  Result<int> mesh = renderer_->add_mesh(model.mesh);
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  // 20 agents on a 5 x 4 grid, 2 m apart, facing the camera-ish with varied headings.
+  std::vector<AgentDraw> agents;
+  std::vector<glm::mat4> palettes(20 * model.joints_per_agent);
+  for (int i = 0; i < 20; ++i) {
+    AgentDraw a;
+    a.position = glm::vec3(-4.0f + 2.0f * (i % 5), 0.0f, -3.0f + 2.0f * (i / 5));
+    a.tint = glm::vec3(0.5f + 0.5f * std::sin(i * 1.7f), 0.5f + 0.5f * std::sin(i * 2.3f + 1.0f),
+                       0.5f + 0.5f * std::sin(i * 3.1f + 2.0f));
+    a.mesh = *mesh;
+    agents.push_back(a);
+    ASSERT_NO_FATAL_FAILURE(model.palette(
+        a.position, 0.3f * i, 0.1f * i,
+        std::span(palettes).subspan(i * model.joints_per_agent, model.joints_per_agent)));
+  }
+  ASSERT_TRUE(renderer_->upload_palettes(palettes, model.joints_per_agent).ok());
+  camera_.distance_m = 14.0f;
+  camera_.pitch_rad = 0.45f;
+  camera_.target = glm::vec3(0.0f, 0.8f, 0.0f);
+
+  FrameCapture empty, crowd;
+  ASSERT_NO_FATAL_FAILURE(render({}, &empty));
+  ASSERT_NO_FATAL_FAILURE(render(agents, &crowd));
+  EXPECT_EQ(renderer_->stats().agents_visible, 20);
+  const std::string dir = scratch_dir("render");
+  ASSERT_TRUE(crowd.save_png(dir + "/crowd_640x360.png").ok());
+  ASSERT_TRUE(empty.save_png(dir + "/empty_640x360.png").ok());
+
+  for (const AgentDraw& a : agents) {
+    const ProjectedPoint p =
+        camera_.project(a.position + glm::vec3(0.0f, model.mid_height_m, 0.0f), viewport());
+    ASSERT_TRUE(p.in_front);
+    const int x = static_cast<int>(p.pixel.x), y = static_cast<int>(p.pixel.y);
+    EXPECT_GT(pixel_difference(crowd.pixel(x, y), empty.pixel(x, y)), 30)
+        << "no agent drawn at " << x << "," << y << " for agent at " << a.position.x << ","
+        << a.position.z;
+  }
+  // Every pixel outside all agents' generous screen bounds must be exactly the empty scene.
+  std::vector<glm::vec4> rects;
+  for (const AgentDraw& a : agents) {
+    glm::vec2 lo, hi;
+    const glm::vec3 r(model.half_width_m, 0.0f, model.half_width_m);
+    screen_bounds(camera_, viewport(), a.position - r,
+                  a.position + r + glm::vec3(0.0f, model.height_m, 0.0f), &lo, &hi);
+    rects.emplace_back(lo.x - 2.0f, lo.y - 2.0f, hi.x + 2.0f, hi.y + 2.0f);
+  }
+  int outside = 0, changed_outside = 0, changed_inside = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const bool inside = std::any_of(rects.begin(), rects.end(), [&](const glm::vec4& r) {
+        return x >= r.x && x <= r.z && y >= r.y && y <= r.w;
+      });
+      const bool changed = crowd.pixel(x, y) != empty.pixel(x, y);
+      if (inside) {
+        changed_inside += changed;
+      } else {
+        ++outside;
+        changed_outside += changed;
+      }
+    }
+  }
+  EXPECT_GT(outside, kWidth * kHeight / 3);  // the check covers a good part of the image
+  EXPECT_EQ(changed_outside, 0);
+  EXPECT_GT(changed_inside, 20 * 200);  // each agent covers at least a few hundred pixels
+}
+
+TEST_F(RendererTest, SkinningRotatesSecondJoint) {
+  Result<int> mesh = renderer_->add_mesh(make_two_bone_column());
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  camera_.target = glm::vec3(0.0f, 1.0f, 0.0f);
+  camera_.pitch_rad = 0.1f;
+  camera_.distance_m = 6.0f;
+  const AgentDraw agent{glm::vec3(0.0f), glm::vec3(1.0f), *mesh};
+  std::vector<glm::mat4> straight(2), bent(2);
+  column_palette(agent.position, 0.0f, straight);
+  column_palette(agent.position, kPi / 2.0f, bent);
+
+  FrameCapture empty, straight_frame, bent_frame;
+  ASSERT_TRUE(renderer_->upload_palettes(straight, 2).ok());
+  ASSERT_NO_FATAL_FAILURE(render({}, &empty));
+  ASSERT_NO_FATAL_FAILURE(render(std::span(&agent, 1), &straight_frame));
+  ASSERT_TRUE(renderer_->upload_palettes(bent, 2).ok());
+  ASSERT_NO_FATAL_FAILURE(render(std::span(&agent, 1), &bent_frame));
+  ASSERT_TRUE(bent_frame.save_png(scratch_dir("render") + "/skinning_bent.png").ok());
+
+  // Upper box: straight it is around (0, 1.7, 0); bent 90 deg about +z it lies along -x at y = 1.
+  const ProjectedPoint up = camera_.project({0.0f, 1.7f, 0.0f}, viewport());
+  const ProjectedPoint side = camera_.project({-0.7f, 1.0f, 0.0f}, viewport());
+  const ProjectedPoint low = camera_.project({0.0f, 0.5f, 0.0f}, viewport());
+  auto at = [](const FrameCapture& f, const ProjectedPoint& p) {
+    return f.pixel(static_cast<int>(p.pixel.x), static_cast<int>(p.pixel.y));
+  };
+  EXPECT_GT(pixel_difference(at(straight_frame, up), at(empty, up)), 30);
+  EXPECT_EQ(pixel_difference(at(straight_frame, side), at(empty, side)), 0);
+  EXPECT_EQ(pixel_difference(at(bent_frame, up), at(empty, up)), 0);
+  EXPECT_GT(pixel_difference(at(bent_frame, side), at(empty, side)), 30);
+  // The lower box is on joint 0 and does not move.
+  EXPECT_GT(pixel_difference(at(bent_frame, low), at(empty, low)), 30);
+  EXPECT_EQ(at(bent_frame, low), at(straight_frame, low));
+  // The upper box is orange, the lower one grey: the bent part must look orange.
+  const glm::u8vec4 c = at(bent_frame, side);
+  EXPECT_GT(c.x, c.z + 40) << int(c.x) << "," << int(c.y) << "," << int(c.z);
+}
+
+TEST_F(RendererTest, OneInstancedDrawPerMeshAndPerAgentTint) {
+  Result<int> a = renderer_->add_mesh(make_two_bone_column(0.4f));
+  Result<int> b = renderer_->add_mesh(make_two_bone_column(0.6f));
+  ASSERT_TRUE(a.ok() && b.ok());
+  std::vector<AgentDraw> agents;
+  std::vector<glm::mat4> palettes(30 * 2);
+  for (int i = 0; i < 30; ++i) {
+    const glm::vec3 p(-5.0f + (i % 10) * 1.1f, 0.0f, -2.0f * (i / 10));
+    const glm::vec3 tint = i == 0 ? glm::vec3(1.0f, 0.1f, 0.1f) : glm::vec3(0.1f, 0.3f, 1.0f);
+    agents.push_back({p, tint, i % 2 == 0 ? *a : *b});
+    column_palette(p, 0.0f, std::span(palettes).subspan(i * 2, 2));
+  }
+  ASSERT_TRUE(renderer_->upload_palettes(palettes, 2).ok());
+  camera_.distance_m = 13.0f;
+  FrameCapture frame;
+  ASSERT_NO_FATAL_FAILURE(render(agents, &frame));
+  EXPECT_EQ(renderer_->stats().agents_visible, 30);
+  EXPECT_EQ(renderer_->stats().skinned_draw_calls, 2);
+  EXPECT_EQ(renderer_->stats().draw_calls, 4);  // ground + 2 meshes + all shadows
+  // Agent 0 is tinted red, agent 1 blue: check their lower boxes.
+  auto body = [&](int i) {
+    const ProjectedPoint p =
+        camera_.project(agents[i].position + glm::vec3(0, 0.5f, 0), viewport());
+    return frame.pixel(static_cast<int>(p.pixel.x), static_cast<int>(p.pixel.y));
+  };
+  EXPECT_GT(body(0).x, body(0).z + 60);
+  EXPECT_GT(body(1).z, body(1).x + 60);
+
+  // Only mesh a in use: one skinned draw.
+  for (AgentDraw& agent : agents) agent.mesh = *a;
+  ASSERT_NO_FATAL_FAILURE(render(agents, &frame));
+  EXPECT_EQ(renderer_->stats().skinned_draw_calls, 1);
+}
+
+TEST_F(RendererTest, CullsAgentsOutsideTheFrustum) {
+  Result<int> mesh = renderer_->add_mesh(make_two_bone_column());
+  ASSERT_TRUE(mesh.ok());
+  // Camera on +z looking toward -z: 10 agents in front, 5 behind the eye, 3 far off to the side.
+  std::vector<AgentDraw> agents;
+  for (int i = 0; i < 10; ++i)
+    agents.push_back({{-3.0f + i * 0.7f, 0, -1.0f}, glm::vec3(1), *mesh});
+  for (int i = 0; i < 5; ++i) agents.push_back({{-2.0f + i, 0, 15.0f}, glm::vec3(1), *mesh});
+  for (int i = 0; i < 3; ++i) agents.push_back({{60.0f + i, 0, 0.0f}, glm::vec3(1), *mesh});
+  std::vector<glm::mat4> palettes(agents.size() * 2);
+  for (size_t i = 0; i < agents.size(); ++i) {
+    column_palette(agents[i].position, 0.0f, std::span(palettes).subspan(i * 2, 2));
+  }
+  ASSERT_TRUE(renderer_->upload_palettes(palettes, 2).ok());
+  ASSERT_GT(camera_.eye().z, 5.0f);
+  ASSERT_LT(camera_.eye().z, 15.0f);
+  FrameCapture culled, unculled;
+  ASSERT_NO_FATAL_FAILURE(render(agents, &culled));
+  EXPECT_EQ(renderer_->stats().agents_submitted, 18);
+  EXPECT_EQ(renderer_->stats().agents_visible, 10);
+  EXPECT_EQ(renderer_->stats().agents_culled, 8);
+  EXPECT_EQ(renderer_->stats().skinned_draw_calls, 1);
+  // Culling must not change the picture.
+  renderer_->settings().cull_agents = false;
+  ASSERT_NO_FATAL_FAILURE(render(agents, &unculled));
+  EXPECT_EQ(renderer_->stats().agents_visible, 18);
+  EXPECT_TRUE(std::equal(culled.rgba().begin(), culled.rgba().end(), unculled.rgba().begin()));
+}
+
+TEST_F(RendererTest, WindingFollowsTheNormalsSoCullingNeverHidesFaces) {
+  SkinnedMesh ccw = make_two_bone_column();
+  SkinnedMesh cw = ccw;  // every triangle clockwise
+  for (size_t t = 0; t < cw.indices.size(); t += 3) std::swap(cw.indices[t + 1], cw.indices[t + 2]);
+  SkinnedMesh mixed = ccw;  // every other triangle clockwise
+  for (size_t t = 0; t < mixed.indices.size(); t += 6) {
+    std::swap(mixed.indices[t + 1], mixed.indices[t + 2]);
+  }
+  Result<int> a = renderer_->add_mesh(ccw), b = renderer_->add_mesh(cw),
+              c = renderer_->add_mesh(mixed);
+  ASSERT_TRUE(a.ok() && b.ok() && c.ok());
+  std::vector<glm::mat4> palette(2);
+  column_palette(glm::vec3(0.0f), 0.3f, palette);
+  ASSERT_TRUE(renderer_->upload_palettes(palette, 2).ok());
+  FrameCapture unculled, frame;
+  AgentDraw agent{glm::vec3(0.0f), glm::vec3(1.0f), *a};
+  renderer_->settings().cull_back_faces = false;
+  ASSERT_NO_FATAL_FAILURE(render(std::span(&agent, 1), &unculled));
+  renderer_->settings().cull_back_faces = true;
+  for (int id : {*a, *b, *c}) {
+    agent.mesh = id;
+    ASSERT_NO_FATAL_FAILURE(render(std::span(&agent, 1), &frame));
+    EXPECT_TRUE(std::equal(unculled.rgba().begin(), unculled.rgba().end(), frame.rgba().begin()))
+        << "mesh " << id << " drawn with back-face culling differs from the unculled original";
+  }
+}
+
+TEST_F(RendererTest, PngAndRawFramesAreWritten) {
+  FrameCapture frame;
+  ASSERT_NO_FATAL_FAILURE(render({}, &frame));
+  const std::string path = scratch_dir("render") + "/capture_check.png";
+  std::remove(path.c_str());
+  ASSERT_TRUE(frame.save_png(path).ok());
+  std::ifstream in(path, std::ios::binary);
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_GT(bytes.size(), 33u);
+  const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  EXPECT_TRUE(std::equal(signature, signature + 8, bytes.begin()));
+  auto be32 = [&](size_t o) {
+    return (bytes[o] << 24) | (bytes[o + 1] << 16) | (bytes[o + 2] << 8) | bytes[o + 3];
+  };
+  EXPECT_EQ(be32(16), kWidth);  // IHDR width and height
+  EXPECT_EQ(be32(20), kHeight);
+  int w = 0, h = 0, channels = 0;
+  unsigned char* decoded = stbi_load(path.c_str(), &w, &h, &channels, 4);
+  ASSERT_NE(decoded, nullptr);
+  EXPECT_EQ(w, kWidth);
+  EXPECT_EQ(h, kHeight);
+  EXPECT_TRUE(std::equal(frame.rgba().begin(), frame.rgba().end(), decoded));
+  stbi_image_free(decoded);
+
+  std::FILE* raw = std::tmpfile();
+  ASSERT_NE(raw, nullptr);
+  ASSERT_TRUE(frame.write_rgb(raw).ok());
+  ASSERT_TRUE(frame.write_rgb(raw).ok());  // frames stream back to back
+  EXPECT_EQ(std::ftell(raw), 2L * kWidth * kHeight * 3);
+  std::rewind(raw);
+  unsigned char first[3];
+  ASSERT_EQ(std::fread(first, 1, 3, raw), 3u);
+  EXPECT_EQ(first[0], frame.pixel(0, 0).x);
+  EXPECT_EQ(first[2], frame.pixel(0, 0).z);
+  std::fclose(raw);
+  EXPECT_FALSE(frame.save_png("/nonexistent-dir/x.png").ok());
+}
+
+}  // namespace
+}  // namespace gk::test
