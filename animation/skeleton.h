@@ -36,7 +36,7 @@ enum class JointRole : uint8_t {
   kRightKnee,
   kRightAnkle,
   kRightToe,
-  kLeftShoulder,
+  kLeftShoulder,  // the upper-arm joint (shoulder rotation centre), not the clavicle
   kRightShoulder,
   kCount
 };

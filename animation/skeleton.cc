@@ -1,0 +1,391 @@
+// Skeleton utilities: role names, role detection from joint names (several rig conventions) with
+// topology checks, the JSON role manifest and structural validation.
+
+#include "animation/skeleton.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace gk {
+namespace {
+
+constexpr std::array<std::string_view, kNumJointRoles> kRoleNames = {
+    "hips",       "spine",       "chest",      "neck",          "head",
+    "left_hip",   "left_knee",   "left_ankle", "left_toe",      "right_hip",
+    "right_knee", "right_ankle", "right_toe",  "left_shoulder", "right_shoulder"};
+
+// What a joint name says once the rig prefix and the side marker are stripped.
+enum class Part {
+  kNone,
+  kHips,
+  kSpine,
+  kNeck,
+  kHead,
+  kThigh,
+  kShin,
+  kFoot,
+  kToe,
+  kArm,
+  kShoulder,
+  kClavicle
+};
+enum class NameSide { kNone, kLeft, kRight };
+
+struct NameInfo {
+  Part part = Part::kNone;
+  NameSide side = NameSide::kNone;
+};
+
+bool is_separator(char c) { return c == '_' || c == '.' || c == '-' || c == ' '; }
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// Base words (separators removed) of each body part, from CMU/cgspeed, Mixamo, Rigify, Unity
+// humanoid, ASF (lfemur, ltibia) and plain (l_knee) conventions.
+Part part_of_base(const std::string& b, bool sided) {
+  if (sided) {
+    if (b == "upleg" || b == "upperleg" || b == "thigh" || b == "hip" || b == "femur") {
+      return Part::kThigh;
+    }
+    if (b == "leg" || b == "knee" || b == "shin" || b == "calf" || b == "lowerleg" ||
+        b == "lowleg" || b == "tibia") {
+      return Part::kShin;
+    }
+    if (b == "foot" || b == "ankle") return Part::kFoot;
+    if (b == "toebase" || b == "toe" || b == "toes" || b == "ball") return Part::kToe;
+    if (b == "arm" || b == "upperarm" || b == "uparm" || b == "humerus") return Part::kArm;
+    if (b == "shoulder") return Part::kShoulder;
+    if (b == "clavicle" || b == "collar") return Part::kClavicle;
+    return Part::kNone;
+  }
+  if (b == "hips" || b == "hip" || b == "pelvis") return Part::kHips;
+  if (b == "head") return Part::kHead;
+  if (b.find("neck") != std::string::npos) return Part::kNeck;
+  if (b.rfind("spine", 0) == 0 || b.rfind("chest", 0) == 0 || b == "upperchest" ||
+      b == "lowerback" || b == "upperback" || b == "thorax" || b == "abdomen" || b == "torso") {
+    return Part::kSpine;
+  }
+  return Part::kNone;
+}
+
+std::string compact(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    if (!is_separator(c)) out += c;
+  }
+  return out;
+}
+
+NameInfo classify(std::string_view raw) {
+  std::string n = lower(raw);
+  // Namespaces (mixamorig:, rig|) and Rigify's deform prefix say nothing about the body part.
+  if (size_t p = n.find_last_of(":|"); p != std::string::npos) n = n.substr(p + 1);
+  if (n.rfind("def-", 0) == 0 || n.rfind("def_", 0) == 0) n = n.substr(4);
+  if (n.rfind("mixamorig", 0) == 0) n = n.substr(9);
+
+  NameInfo info;
+  std::string base = n;
+  auto strip_prefix = [&](std::string_view word, NameSide side) {
+    if (n.rfind(word, 0) != 0) return false;
+    info.side = side;
+    base = n.substr(word.size());
+    return true;
+  };
+  auto strip_suffix = [&](std::string_view word, NameSide side) {
+    if (n.size() <= word.size() || n.compare(n.size() - word.size(), word.size(), word) != 0) {
+      return false;
+    }
+    info.side = side;
+    base = n.substr(0, n.size() - word.size());
+    return true;
+  };
+  const bool sided =
+      strip_prefix("left", NameSide::kLeft) || strip_prefix("right", NameSide::kRight) ||
+      strip_suffix("left", NameSide::kLeft) || strip_suffix("right", NameSide::kRight) ||
+      (n.size() > 2 && n[0] == 'l' && is_separator(n[1]) &&
+       strip_prefix(n.substr(0, 2), NameSide::kLeft)) ||
+      (n.size() > 2 && n[0] == 'r' && is_separator(n[1]) &&
+       strip_prefix(n.substr(0, 2), NameSide::kRight)) ||
+      (n.size() > 2 && n.back() == 'l' && is_separator(n[n.size() - 2]) &&
+       strip_suffix(n.substr(n.size() - 2), NameSide::kLeft)) ||
+      (n.size() > 2 && n.back() == 'r' && is_separator(n[n.size() - 2]) &&
+       strip_suffix(n.substr(n.size() - 2), NameSide::kRight));
+  if (sided) {
+    info.part = part_of_base(compact(base), true);
+    return info;
+  }
+  const std::string c = compact(n);
+  info.part = part_of_base(c, false);
+  // ASF style ("lfemur", "rtibia"): a bare l/r prefix counts only when the rest is a known part,
+  // so that "leg" or "lowerback" are not read as sided.
+  if (info.part == Part::kNone && c.size() > 1 && (c[0] == 'l' || c[0] == 'r')) {
+    Part p = part_of_base(c.substr(1), true);
+    if (p != Part::kNone) {
+      info.part = p;
+      info.side = c[0] == 'l' ? NameSide::kLeft : NameSide::kRight;
+    }
+  }
+  return info;
+}
+
+bool is_descendant(const Skeleton& s, int joint, int ancestor) {
+  for (int j = s.parents[joint]; j >= 0; j = s.parents[j]) {
+    if (j == ancestor) return true;
+  }
+  return false;
+}
+
+int depth_below(const Skeleton& s, int joint, int ancestor) {
+  int d = 0;
+  for (int j = joint; j >= 0 && j != ancestor; j = s.parents[j]) ++d;
+  return d;
+}
+
+// Among the joints tagged `part` on `side` below `ancestor` (any joint when -1), the one closest to
+// it; the topology check that keeps a knee below its hip.
+int nearest_below(const Skeleton& s, const std::vector<NameInfo>& info, Part part, NameSide side,
+                  int ancestor) {
+  int best = -1;
+  int best_depth = 1 << 30;
+  for (int j = 0; j < s.num_joints(); ++j) {
+    if (info[j].part != part || info[j].side != side) continue;
+    if (ancestor >= 0 && !is_descendant(s, j, ancestor)) continue;
+    const int d = ancestor >= 0 ? depth_below(s, j, ancestor) : depth_below(s, j, -1);
+    if (d < best_depth) {
+      best = j;
+      best_depth = d;
+    }
+  }
+  return best;
+}
+
+int common_ancestor(const Skeleton& s, int a, int b) {
+  for (int x = a; x >= 0; x = s.parents[x]) {
+    if (x == b || is_descendant(s, b, x)) return x;
+  }
+  return -1;
+}
+
+void set_role(Skeleton* s, JointRole r, int joint) { s->roles[static_cast<int>(r)] = joint; }
+
+void detect_leg(Skeleton* s, const std::vector<NameInfo>& info, NameSide side, int hips) {
+  const bool left = side == NameSide::kLeft;
+  int hip = -1, knee = -1, ankle = -1, toe = -1;
+  // Prefer the thigh candidate that has a complete chain below it (some rigs name a pelvis-side
+  // helper "LeftHip" above the real thigh).
+  for (int j = 0; j < s->num_joints(); ++j) {
+    if (info[j].part != Part::kThigh || info[j].side != side) continue;
+    if (hips >= 0 && !is_descendant(*s, j, hips)) continue;
+    const int k = nearest_below(*s, info, Part::kShin, side, j);
+    const int a = k >= 0 ? nearest_below(*s, info, Part::kFoot, side, k) : -1;
+    if (hip < 0 || (a >= 0 && ankle < 0)) {
+      hip = j;
+      knee = k;
+      ankle = a;
+    }
+  }
+  if (ankle >= 0) toe = nearest_below(*s, info, Part::kToe, side, ankle);
+  set_role(s, left ? JointRole::kLeftHip : JointRole::kRightHip, hip);
+  set_role(s, left ? JointRole::kLeftKnee : JointRole::kRightKnee, knee);
+  set_role(s, left ? JointRole::kLeftAnkle : JointRole::kRightAnkle, ankle);
+  set_role(s, left ? JointRole::kLeftToe : JointRole::kRightToe, toe);
+}
+
+// spine_chain: the path from just above the hips up to the chest.
+void rebuild_spine_chain(Skeleton* s) {
+  s->spine_chain.clear();
+  const int hips = s->role(JointRole::kHips);
+  const int chest = s->role(JointRole::kChest);
+  if (hips < 0 || chest < 0 || !is_descendant(*s, chest, hips)) return;
+  for (int j = chest; j >= 0 && j != hips; j = s->parents[j]) {
+    s->spine_chain.push_back(static_cast<int16_t>(j));
+  }
+  std::reverse(s->spine_chain.begin(), s->spine_chain.end());
+}
+
+}  // namespace
+
+std::string_view joint_role_name(JointRole role) {
+  const int i = static_cast<int>(role);
+  return i >= 0 && i < kNumJointRoles ? kRoleNames[i] : "unknown";
+}
+
+bool joint_role_from_name(std::string_view name, JointRole* out_role) {
+  for (int i = 0; i < kNumJointRoles; ++i) {
+    if (kRoleNames[i] == name) {
+      *out_role = static_cast<JointRole>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+int Skeleton::find(std::string_view name) const {
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+bool Skeleton::has_locomotion_roles() const {
+  for (JointRole r :
+       {JointRole::kHips, JointRole::kChest, JointRole::kLeftHip, JointRole::kLeftKnee,
+        JointRole::kLeftAnkle, JointRole::kLeftToe, JointRole::kRightHip, JointRole::kRightKnee,
+        JointRole::kRightAnkle, JointRole::kRightToe}) {
+    if (!has(r)) return false;
+  }
+  return true;
+}
+
+void detect_joint_roles(Skeleton* s) {
+  s->roles.fill(-1);
+  s->spine_chain.clear();
+  const int n = s->num_joints();
+  std::vector<NameInfo> info(n);
+  for (int j = 0; j < n; ++j) info[j] = classify(s->names[j]);
+
+  int hips = nearest_below(*s, info, Part::kHips, NameSide::kNone, -1);
+  detect_leg(s, info, NameSide::kLeft, hips);
+  detect_leg(s, info, NameSide::kRight, hips);
+  // Without a hips name, the pelvis is where the two legs meet.
+  if (hips < 0 && s->has(JointRole::kLeftHip) && s->has(JointRole::kRightHip)) {
+    hips = common_ancestor(*s, s->role(JointRole::kLeftHip), s->role(JointRole::kRightHip));
+  }
+  set_role(s, JointRole::kHips, hips);
+
+  const int neck = nearest_below(*s, info, Part::kNeck, NameSide::kNone, hips);
+  set_role(s, JointRole::kNeck, neck);
+  const int head = nearest_below(*s, info, Part::kHead, NameSide::kNone, neck >= 0 ? neck : hips);
+  set_role(s, JointRole::kHead, head);
+  // Chest = the last joint below the neck (the neck base). With no neck, the topmost spine-named
+  // joint of the chain.
+  int chest = -1;
+  const int top = neck >= 0 ? neck : head;
+  if (top >= 0 && hips >= 0 && s->parents[top] != hips && s->parents[top] >= 0) {
+    chest = s->parents[top];
+  } else if (top < 0) {
+    for (int j = 0; j < n; ++j) {
+      if (info[j].part == Part::kSpine && (hips < 0 || is_descendant(*s, j, hips)) &&
+          (chest < 0 || is_descendant(*s, j, chest))) {
+        chest = j;
+      }
+    }
+  }
+  set_role(s, JointRole::kChest, chest);
+  rebuild_spine_chain(s);
+  if (!s->spine_chain.empty()) set_role(s, JointRole::kSpine, s->spine_chain.front());
+
+  // Shoulder = the upper-arm joint (the shoulder's rotation centre). "LeftShoulder" is a clavicle
+  // when the rig also has "LeftArm" (CMU, Mixamo; it sits on the spine there) and the upper arm
+  // when it has "LeftCollar" instead (cgspeed's LeftHip/LeftKnee form).
+  const int arms_root = chest >= 0 ? chest : hips;
+  for (NameSide side : {NameSide::kLeft, NameSide::kRight}) {
+    int j = nearest_below(*s, info, Part::kArm, side, arms_root);
+    if (j < 0) j = nearest_below(*s, info, Part::kShoulder, side, arms_root);
+    if (j < 0) j = nearest_below(*s, info, Part::kClavicle, side, arms_root);
+    set_role(s, side == NameSide::kLeft ? JointRole::kLeftShoulder : JointRole::kRightShoulder, j);
+  }
+}
+
+Status apply_role_manifest_text(std::string_view json_text, const std::string& source_name,
+                                Skeleton* skeleton) {
+  nlohmann::json doc = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) return Status::Error(source_name + ": not valid JSON");
+  if (!doc.is_object() || !doc.contains("roles")) {
+    return Status::AtField(source_name, "roles", "missing (expected {\"roles\": {...}})");
+  }
+  const nlohmann::json& roles = doc["roles"];
+  if (!roles.is_object()) {
+    return Status::AtField(source_name, "roles", "expected an object of role: joint name");
+  }
+  Skeleton updated = *skeleton;
+  for (const auto& [key, value] : roles.items()) {
+    const std::string field = "roles." + key;
+    JointRole role;
+    if (!joint_role_from_name(key, &role)) {
+      std::string known;
+      for (std::string_view r : kRoleNames) known += (known.empty() ? "" : ", ") + std::string(r);
+      return Status::AtField(source_name, field, "unknown role (expected one of " + known + ")");
+    }
+    if (value.is_null()) {  // null removes a wrongly detected role
+      set_role(&updated, role, -1);
+      continue;
+    }
+    if (!value.is_string()) {
+      return Status::AtField(source_name, field, "expected a joint name (string) or null");
+    }
+    const int j = updated.find(value.get<std::string>());
+    if (j < 0) {
+      return Status::AtField(source_name, field,
+                             "no joint named '" + value.get<std::string>() + "' in the skeleton");
+    }
+    set_role(&updated, role, j);
+  }
+  rebuild_spine_chain(&updated);
+  if (!updated.spine_chain.empty() && roles.contains("spine") && updated.has(JointRole::kSpine)) {
+    // An explicit spine start trims the chain to begin there.
+    auto it = std::find(updated.spine_chain.begin(), updated.spine_chain.end(),
+                        updated.role(JointRole::kSpine));
+    if (it != updated.spine_chain.end()) updated.spine_chain.erase(updated.spine_chain.begin(), it);
+  } else if (!updated.spine_chain.empty()) {
+    set_role(&updated, JointRole::kSpine, updated.spine_chain.front());
+  }
+  *skeleton = std::move(updated);
+  return Status::Ok();
+}
+
+Status apply_role_manifest(const std::string& manifest_path, Skeleton* skeleton) {
+  std::ifstream in(manifest_path, std::ios::binary);
+  if (!in) return Status::Error(manifest_path + ": cannot open role manifest");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return apply_role_manifest_text(ss.str(), manifest_path, skeleton);
+}
+
+Status validate_skeleton(const Skeleton& s, const std::string& source_name) {
+  const size_t n = s.parents.size();
+  if (n == 0) return Status::Error(source_name + ": skeleton has no joints");
+  if (n > 32767)
+    return Status::Error(source_name + ": too many joints (" + std::to_string(n) + ")");
+  if (s.names.size() != n || s.rest_translations.size() != n || s.rest_rotations.size() != n) {
+    return Status::Error(source_name + ": skeleton arrays disagree in size");
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const std::string where = "joint " + std::to_string(i) + " '" + s.names[i] + "'";
+    if (s.parents[i] < -1 || s.parents[i] >= static_cast<int>(i)) {
+      return Status::AtField(source_name, where,
+                             "parent " + std::to_string(s.parents[i]) + " is not an earlier joint");
+    }
+    const glm::vec3& t = s.rest_translations[i];
+    const glm::quat& q = s.rest_rotations[i];
+    if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z)) {
+      return Status::AtField(source_name, where, "rest translation is not finite");
+    }
+    const float len = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    if (!std::isfinite(len) || std::abs(len - 1.0f) > 1e-3f) {
+      return Status::AtField(source_name, where, "rest rotation is not a unit quaternion");
+    }
+  }
+  for (int r = 0; r < kNumJointRoles; ++r) {
+    if (s.roles[r] < -1 || s.roles[r] >= static_cast<int>(n)) {
+      return Status::AtField(source_name, "roles." + std::string(kRoleNames[r]), "out of range");
+    }
+  }
+  for (int16_t j : s.spine_chain) {
+    if (j < 0 || j >= static_cast<int>(n)) {
+      return Status::AtField(source_name, "spine_chain", "joint index out of range");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace gk
