@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include "animation/pose_jobs.h"
 
@@ -17,10 +18,10 @@ constexpr float kMaxGaitSpeed = 12.0f;  // [m/s] faster ones are not locomotion
 constexpr float kMetricRateHz = 60.0f;
 
 // Clips whose names say they are not walking/running are left out of the blend space.
-constexpr std::array<const char*, 22> kNonLocomotion = {
-    "crouch", "swim", "jump", "sit", "crawl", "climb", "death", "dead", "punch", "kick", "roll",
-    "fall",   "hit",  "pistol", "sword", "spell", "interact", "push", "pick", "dance", "tpose",
-    "t-pose"};
+constexpr std::array<const char*, 24> kNonLocomotion = {
+    "crouch",   "swim", "jump", "sit",   "crawl", "climb",  "death", "dead",
+    "punch",    "kick", "roll", "fall",  "hit",   "pistol", "sword", "spell",
+    "interact", "push", "pick", "dance", "tpose", "t-pose", "driv",  "ride"};
 
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -99,8 +100,8 @@ float clip_facing(const Clip& c, const Skeleton& sk) {
                     glm::mat4(1.0f),
                     model}
         .run();
-    const glm::vec3 lr = translation_of(model[sk.hip(Side::kLeft)]) -
-                         translation_of(model[sk.hip(Side::kRight)]);
+    const glm::vec3 lr =
+        translation_of(model[sk.hip(Side::kLeft)]) - translation_of(model[sk.hip(Side::kRight)]);
     sum += glm::cross(lr, glm::vec3(0, 1, 0));
   }
   return std::atan2(sum.x, sum.z);
@@ -147,11 +148,11 @@ bool build_phase_table(LocomotionClip* lc) {
   return lc->cycle_s > 0.0f;
 }
 
-constexpr float kPlantToe = 0.035f;     // [m] METRICS.md contact (2.5 cm) with a margin: toe this low
-constexpr float kPlantAnkle = 0.06f;    // [m] and the ankle within this of its lowest (5 cm + margin)
-constexpr float kPlantSpeed = 1.5f;     // [m/s] a foot moving faster over the ground is swinging
-constexpr float kHoldToe = 0.035f;      // [m] a lock is kept until the toe rises past this
-constexpr float kHoldAnkle = 0.07f;     // [m] or the ankle past this (heel-off pivots on the ball)
+constexpr float kPlantToe = 0.035f;   // [m] METRICS.md contact (2.5 cm) with a margin: toe this low
+constexpr float kPlantAnkle = 0.06f;  // [m] and the ankle within this of its lowest (5 cm + margin)
+constexpr float kPlantSpeed = 1.5f;   // [m/s] a foot moving faster over the ground is swinging
+constexpr float kHoldToe = 0.035f;    // [m] a lock is kept until the toe rises past this
+constexpr float kHoldAnkle = 0.07f;   // [m] or the ankle past this (heel-off pivots on the ball)
 
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
   const Clip& c = lc->clip;
@@ -171,8 +172,8 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     }
   }
   // The in-place clip's feet move backward under the body at the travel velocity; add it back.
-  const glm::vec3 travel = lc->speed_m_s *
-                           glm::vec3(std::sin(lc->direction_rad), 0.0f, std::cos(lc->direction_rad));
+  const glm::vec3 travel =
+      lc->speed_m_s * glm::vec3(std::sin(lc->direction_rad), 0.0f, std::cos(lc->direction_rad));
   for (int s = 0; s < 2; ++s) {
     lc->plant[s].assign(n, 0);
     lc->hold[s].assign(n, 0);
@@ -197,7 +198,8 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
       const float speed = std::hypot(vel.x, vel.z);
       const float ht = toe[s][f].y - min_t, ha = ankle[s][f].y - min_a;
       lc->toe_height_m[s][f] = ht;
-      lc->plant[s][f] = analysed[f] || (ht <= kPlantToe && ha <= kPlantAnkle && speed < kPlantSpeed);
+      lc->plant[s][f] =
+          analysed[f] || (ht <= kPlantToe && ha <= kPlantAnkle && speed < kPlantSpeed);
       lc->hold[s][f] = lc->plant[s][f] || (ht <= kHoldToe && ha <= kHoldAnkle);
     }
   }
@@ -236,8 +238,8 @@ LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
                     glm::mat4(1.0f),
                     model}
         .run();
-    glm::vec3 d = translation_of(model[sk.toe(Side::kLeft)]) -
-                  translation_of(model[sk.toe(Side::kRight)]);
+    glm::vec3 d =
+        translation_of(model[sk.toe(Side::kLeft)]) - translation_of(model[sk.toe(Side::kRight)]);
     const float planted = gait.toe_height_m[0][f] + gait.toe_height_m[1][f] +
                           (gait.plant[0][f] && gait.plant[1][f] ? 0.0f : 1.0f);
     const float score = std::hypot(d.x, d.z) + 4.0f * planted;
@@ -305,8 +307,8 @@ Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, f
         continue;
       }
       out.rotations[o] = clip.frame_rotations(f)[s];
-      out.translations[o] =
-          dst.parents[j] < 0 ? clip.frame_translations(f)[s] * root_scale : dst.rest_translations[j];
+      out.translations[o] = dst.parents[j] < 0 ? clip.frame_translations(f)[s] * root_scale
+                                               : dst.rest_translations[j];
     }
   }
   return out;
@@ -319,9 +321,10 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   lib.mesh = sets[0].mesh;
   const Skeleton& sk = *lib.skeleton;
   if (!sk.has_locomotion_roles()) {
-    return Status::Error(sets[0].source +
-                         ": skeleton lacks the hips/leg joints the mediator needs (hips, hip, knee, "
-                         "ankle and toe on both sides); give a role manifest");
+    return Status::Error(
+        sets[0].source +
+        ": skeleton lacks the hips/leg joints the mediator needs (hips, hip, knee, "
+        "ankle and toe on both sides); give a role manifest");
   }
   const std::vector<glm::mat4> rest = rest_model(sk);
   for (int s = 0; s < 2; ++s) lib.leg_length_m[s] = leg_length(sk, rest, static_cast<Side>(s));
@@ -334,8 +337,8 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       return Status::Error(set.source + ": skeleton lacks the hips/leg joints the mediator needs");
     }
     const std::vector<glm::mat4> src_rest = rest_model(src);
-    const float src_leg = 0.5f * (leg_length(src, src_rest, Side::kLeft) +
-                                  leg_length(src, src_rest, Side::kRight));
+    const float src_leg =
+        0.5f * (leg_length(src, src_rest, Side::kLeft) + leg_length(src, src_rest, Side::kRight));
     const bool same = set.skeleton == lib.skeleton;
     for (const Clip& original : set.clips) {
       if (name_excluded(original.name) || original.num_frames < 2) continue;
@@ -364,8 +367,9 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     }
   }
   if (lib.clips.empty()) {
-    return Status::Error("clip library: no walking or running clip found (a clip needs a travel speed "
-                         "of 0.25-12 m/s and foot contacts on both feet)");
+    return Status::Error(
+        "clip library: no walking or running clip found (a clip needs a travel speed "
+        "of 0.25-12 m/s and foot contacts on both feet)");
   }
   // Direction groups: forward, left, right, backward, or their own direction.
   for (int i = 0; i < static_cast<int>(lib.clips.size()); ++i) {
@@ -374,8 +378,9 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       if (std::abs(wrap_angle(d - snap)) < glm::radians(30.0f)) d = snap == -kPi ? kPi : snap;
     }
     if (std::abs(wrap_angle(d - kPi)) < 1e-4f) d = kPi;
-    auto it = std::find_if(lib.groups.begin(), lib.groups.end(),
-                           [&](const DirectionGroup& g) { return std::abs(g.direction_rad - d) < 1e-4f; });
+    auto it = std::find_if(lib.groups.begin(), lib.groups.end(), [&](const DirectionGroup& g) {
+      return std::abs(g.direction_rad - d) < 1e-4f;
+    });
     if (it == lib.groups.end()) {
       lib.groups.push_back({d, {}});
       it = lib.groups.end() - 1;
@@ -384,24 +389,34 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     lib.max_speed_m_s = std::max(lib.max_speed_m_s, lib.clips[i].speed_m_s);
   }
   std::sort(lib.groups.begin(), lib.groups.end(),
-            [](const DirectionGroup& a, const DirectionGroup& b) { return a.direction_rad < b.direction_rad; });
+            [](const DirectionGroup& a, const DirectionGroup& b) {
+              return a.direction_rad < b.direction_rad;
+            });
   for (size_t g = 0; g < lib.groups.size(); ++g) {
     auto& v = lib.groups[g].clips;
-    std::sort(v.begin(), v.end(), [&](int a, int b) { return lib.clips[a].speed_m_s < lib.clips[b].speed_m_s; });
+    std::sort(v.begin(), v.end(),
+              [&](int a, int b) { return lib.clips[a].speed_m_s < lib.clips[b].speed_m_s; });
     if (lib.groups[g].direction_rad == 0.0f) lib.forward_group = static_cast<int>(g);
   }
   if (lib.forward_group < 0) {
-    return Status::Error("clip library: no forward walking clip found (all clips travel sideways or "
-                         "backward)");
+    return Status::Error(
+        "clip library: no forward walking clip found (all clips travel sideways or "
+        "backward)");
   }
   // Idle: the calmest standing clip, else a standing frame of the slowest forward clip.
   if (!idles.empty()) {
-    auto calm = std::min_element(idles.begin(), idles.end(), [](const auto& a, const auto& b) {
-      return a.analysis.floor.mean_cm_s < b.analysis.floor.mean_cm_s;
-    });
+    // A clip named idle first (the plainest name: "Idle_Loop" before "Idle_Talking_Loop"), then
+    // the calmest feet.
+    auto rank = [](const LocomotionClip& c) {
+      return std::make_tuple(lower(c.clip.name).find("idle") == std::string::npos ? 1 : 0,
+                             c.clip.name.size(), c.analysis.floor.mean_cm_s);
+    };
+    auto calm = std::min_element(idles.begin(), idles.end(),
+                                 [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
     lib.clips.push_back(std::move(*calm));
   } else {
-    lib.clips.push_back(synthesise_idle(lib.clips[lib.groups[lib.forward_group].clips.front()], sk));
+    lib.clips.push_back(
+        synthesise_idle(lib.clips[lib.groups[lib.forward_group].clips.front()], sk));
   }
   lib.idle = static_cast<int>(lib.clips.size()) - 1;
   for (int s = 0; s < 2; ++s) {
@@ -414,7 +429,8 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     }
   }
   for (const LocomotionClip& c : lib.clips) {
-    lib.max_rotation_step_rad = std::max(lib.max_rotation_step_rad, max_rotation_step(c.clip, sk.num_joints()));
+    lib.max_rotation_step_rad =
+        std::max(lib.max_rotation_step_rad, max_rotation_step(c.clip, sk.num_joints()));
   }
   return lib;
 }

@@ -1,0 +1,103 @@
+// Mediator planning and pose synthesis (sample, blend, FK, torso twist, foot IK, skinning
+// palettes), microseconds per agent per frame at 1,000 agents, single thread, for three skeletons:
+// the built-in humanoid (25 joints), the CMU walk + run (31) and the Quaternius mannequin (53).
+// The crowd is the plaza scenario on social forces, stepped for two seconds first.
+#include <cstdlib>
+#include <string>
+
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include "animation/clip_library.h"
+#include "animation/procedural.h"
+#include "crowd/scenario.h"
+#include "crowd/social_forces.h"
+#include "mediator/mediator.h"
+#include "mediator/pose_synthesis.h"
+
+namespace {
+
+constexpr float kDt = 1.0f / 60.0f;
+
+std::string data_dir() {
+  const char* env = std::getenv("GAITKEEPER_DATA");
+  return env && *env ? env : GK_DEFAULT_DATA_DIR;
+}
+
+// 0: built-in, 1: CMU walk + run, 2: mannequin glb.
+gk::Result<gk::LocomotionLibrary> library(int which) {
+  std::vector<gk::ClipSet> sets;
+  if (which == 0) {
+    sets.push_back(gk::make_builtin_clip_set());
+  } else {
+    const std::vector<std::string> files =
+        which == 1 ? std::vector<std::string>{"clips/bvh/cmu_07_01_walk.bvh",
+                                              "clips/bvh/cmu_09_11_run.bvh"}
+                   : std::vector<std::string>{"clips/gltf/ual_mannequin_quaternius.glb"};
+    for (const std::string& f : files) {
+      auto set = gk::load_clip_file(data_dir() + "/" + f);
+      if (!set.ok()) return set.status();
+      sets.push_back(std::move(*set));
+    }
+  }
+  return gk::build_locomotion_library(sets);
+}
+
+struct Fixture {
+  gk::LocomotionLibrary lib;
+  std::unique_ptr<gk::SocialForces> sim;
+};
+
+void BM_MediatorAndPose(benchmark::State& state) {
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const int n = 1000;
+  auto lib = library(static_cast<int>(state.range(0)));
+  if (!lib.ok()) {
+    state.SkipWithError(lib.message().c_str());
+    return;
+  }
+  auto loaded = gk::load_scenario_by_name("plaza", gk::scenario_dir());
+  if (!loaded.ok()) {
+    state.SkipWithError(loaded.message().c_str());
+    return;
+  }
+  const gk::Scenario scenario = gk::scale_scenario(*loaded, n);
+  auto agents = gk::expand_agents(scenario, n, 1);
+  auto sim = gk::SocialForces::create(scenario, *agents, gk::SocialForceParams{});
+  if (!agents.ok() || !sim.ok()) {
+    state.SkipWithError("plaza scenario could not be created");
+    return;
+  }
+  gk::CrowdSource& crowd = **sim;
+  gk::Mediator mediator(*lib, gk::MediatorParams{}, crowd.capacity());
+  gk::PoseSynthesizer poses(*lib, crowd.capacity(), /*make_palettes=*/true);
+  for (int i = 0; i < 120; ++i) {
+    (void)crowd.step(kDt);
+    (void)mediator.plan(crowd.frame(), kDt);
+    poses.run(mediator, kDt);
+  }
+  const bool pose_only = state.range(1) == 1;
+  for (auto _ : state) {
+    state.PauseTiming();
+    (void)crowd.step(kDt);
+    if (pose_only) (void)mediator.plan(crowd.frame(), kDt);
+    state.ResumeTiming();
+    if (!pose_only) benchmark::DoNotOptimize(mediator.plan(crowd.frame(), kDt));
+    if (pose_only) poses.run(mediator, kDt);
+  }
+  state.counters["joints"] = lib->skeleton->num_joints();
+  state.counters["sec_per_agent"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * n,
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert, benchmark::Counter::kIs1000);
+  state.SetLabel(std::string(state.range(1) == 1 ? "pose" : "mediator") + ", " +
+                 (state.range(0) == 0 ? "built-in" : state.range(0) == 1 ? "CMU" : "mannequin"));
+}
+
+}  // namespace
+
+BENCHMARK(BM_MediatorAndPose)
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK_MAIN();

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The quality matrix of the mediator: every built-in scenario on both simulators and every
+# trajectory file in the shared data, with the built-in clips, the mannequin glTF clips and the two
+# CMU clips, in naive and apm modes, 60 Hz, 600 frames. Writes a Markdown table (stdout, and
+# bench/quality.md unless QUALITY_OUT is set) and keeps every JSON report in $QUALITY_DIR.
+# Usage: bench/quality.sh [--frames F] [--agents N]   (needs jq and a built ./build/app/gaitkeeper)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+gk=${GAITKEEPER:-./build/app/gaitkeeper}
+data=${GAITKEEPER_DATA:-$(cd .. && pwd)/shared/data}
+frames=600
+agents=""
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --frames) frames=$2; shift 2 ;;
+    --agents) agents="--agents $2"; shift 2 ;;
+    *) echo "quality.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+out=${QUALITY_OUT:-bench/quality.md}
+dir=${QUALITY_DIR:-build/quality}
+mkdir -p "$dir"
+command -v jq >/dev/null || { echo "quality.sh: needs jq (apt-get install jq)" >&2; exit 2; }
+[[ -x $gk ]] || { echo "quality.sh: $gk not built (run scripts/setup.sh)" >&2; exit 2; }
+
+declare -A clipsets=(
+  [builtin]=""
+  [mannequin]="--clips $data/clips/gltf/ual_mannequin_quaternius.glb"
+  [cmu]="--clips $data/clips/bvh/cmu_07_01_walk.bvh $data/clips/bvh/cmu_09_11_run.bvh"
+)
+runs=()
+for sc in corridor crossing circle bottleneck plaza gallery; do
+  for sim in social detour; do runs+=("$sc|--scenario $sc --sim $sim $agents|$sim"); done
+done
+for f in "$data"/trajectories/*/*.txt; do
+  ft=0.4
+  [[ $(basename "$f") == biwi_eth.txt ]] && ft=0.667  # PROVENANCE.md: one step spans 0.667 s
+  runs+=("$(basename "$f" .txt)|--scenario $f --trajectory-frame-time $ft|replay")
+done
+
+{
+  echo "| scenario | sim | clips | mode | slide cm/s (floor) | skate | torsion max | facing p95 | heading p95 | root mean/max cm | rate outside | pops | naive/apm slide |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+} > "$out.tmp"
+total=$(( ${#runs[@]} * 3 * 2 ))
+k=0
+for run in "${runs[@]}"; do
+  IFS='|' read -r name args sim <<<"$run"
+  for cs in builtin mannequin cmu; do
+    declare -A slide=()
+    for mode in naive apm; do
+      k=$((k + 1))
+      json="$dir/${name}_${sim}_${cs}_${mode}.json"
+      echo "[$k/$total] $name $sim $cs $mode" >&2
+      # shellcheck disable=SC2086
+      if ! $gk bench $args ${clipsets[$cs]} --mode $mode --frames "$frames" --json "$json" >/dev/null 2>"$json.err"; then
+        echo "| $name | $sim | $cs | $mode | failed: $(tail -1 "$json.err") |||||||||" >> "$out.tmp"
+        continue
+      fi
+      slide[$mode]=$(jq '.metrics.foot_slide_cm_s // 0' "$json")
+      jq -r --arg n "$name" --arg s "$sim" --arg c "$cs" --arg m "$mode" '
+        def f(x; d): if x == null then "n/a" else (x * pow(10; d) | round / pow(10; d) | tostring) end;
+        .metrics as $m |
+        "| \($n) | \($s) | \($c) | \($m) | \(f($m.foot_slide_cm_s; 2)) (\(f($m.foot_slide_floor_cm_s; 2))) | \(f($m.skate_ratio; 4)) | \(f($m.torsion_deg.max; 1)) | \(f($m.facing_error_deg.p95; 1)) | \(f($m.heading_error_deg.p95; 1)) | \(f($m.root_error_cm.mean; 2))/\(f($m.root_error_cm.max; 2)) | \(f($m.playback_rate.outside_limits; 4)) | \($m.pop_count) |"' \
+        "$json" | tr -d '\n' >> "$out.tmp"
+      if [[ $mode == apm ]]; then
+        awk -v n="${slide[naive]:-0}" -v a="${slide[apm]}" 'BEGIN { if (a > 0) printf " %.1fx |\n", n / a; else print " n/a |" }' >> "$out.tmp"
+      else
+        echo " |" >> "$out.tmp"
+      fi
+    done
+  done
+done
+mv "$out.tmp" "$out"
+cat "$out"

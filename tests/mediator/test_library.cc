@@ -1,0 +1,107 @@
+// The mediator's clip library built from the built-in set, the real CMU pair (two actors) and the
+// Quaternius glb: what it keeps, how it retargets, and its phase tables.
+
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "animation/clip_library.h"
+#include "animation/pose_jobs.h"
+#include "tests/mediator/mediator_fixture.h"
+#include "tests/test_data.h"
+
+namespace gk {
+namespace {
+
+const LocomotionClip* find(const LocomotionLibrary& lib, const std::string& name) {
+  for (const LocomotionClip& c : lib.clips) {
+    if (c.clip.name == name) return &c;
+  }
+  return nullptr;
+}
+
+TEST(LocomotionLibrary, BuiltinBlendSpace) {
+  const LocomotionLibrary& lib = test::builtin_library();
+  ASSERT_EQ(lib.clips.size(), 9u);
+  ASSERT_GE(lib.idle, 0);
+  EXPECT_EQ(lib.clips[lib.idle].clip.name, "idle");
+  // Forward, left, right and backward groups, each sorted by speed.
+  ASSERT_EQ(lib.groups.size(), 4u);
+  for (const DirectionGroup& g : lib.groups) {
+    for (size_t k = 1; k < g.clips.size(); ++k) {
+      EXPECT_LE(lib.clips[g.clips[k - 1]].speed_m_s, lib.clips[g.clips[k]].speed_m_s);
+    }
+  }
+  EXPECT_EQ(lib.groups[lib.forward_group].clips.size(), 5u);
+  // Phase tables run forward over exactly one cycle.
+  for (const LocomotionClip& c : lib.clips) {
+    if (!c.gait) continue;
+    for (int k = 1; k <= kPhaseTableSize; ++k) EXPECT_GE(c.phase_to_time[k], c.phase_to_time[k - 1]);
+    EXPECT_NEAR(c.phase_to_time[kPhaseTableSize] - c.phase_to_time[0], c.cycle_s, 1e-4f);
+  }
+}
+
+TEST(LocomotionLibrary, InPlaceClipsKeepOnlyTheSway) {
+  // The in-place walk's hips stay within a few centimetres of the origin horizontally.
+  const LocomotionLibrary& lib = test::builtin_library();
+  const LocomotionClip* walk = find(lib, "walk");
+  ASSERT_NE(walk, nullptr);
+  for (int f = 0; f < walk->clip.num_frames; ++f) {
+    const glm::vec3 t = walk->clip.frame_translations(f)[0];
+    EXPECT_LT(std::hypot(t.x, t.z), 0.06f) << f;
+  }
+}
+
+TEST(LocomotionLibrary, TwoActorsOfTheCmuRetargetedOntoOne) {
+  GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
+  std::vector<ClipSet> sets;
+  for (const char* f : {"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"}) {
+    auto set = load_clip_file(test::data_path(f));
+    ASSERT_TRUE(set.ok()) << set.message();
+    sets.push_back(std::move(*set));
+  }
+  // Leg lengths of the two actors, to predict the run's speed on the walker's body.
+  auto leg = [](const Skeleton& sk) {
+    std::vector<glm::mat4> m(sk.num_joints());
+    LocalToModelJob{&sk, sk.rest_rotations, sk.rest_translations, glm::mat4(1.0f), m}.run();
+    const Side s = Side::kLeft;
+    return glm::length(translation_of(m[sk.knee(s)]) - translation_of(m[sk.hip(s)])) +
+           glm::length(translation_of(m[sk.ankle(s)]) - translation_of(m[sk.knee(s)]));
+  };
+  const float ratio = leg(*sets[0].skeleton) / leg(*sets[1].skeleton);
+  auto lib = build_locomotion_library(sets);
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  EXPECT_EQ(lib->skeleton, sets[0].skeleton);
+  const LocomotionClip* walk = find(*lib, "cmu_07_01_walk");
+  const LocomotionClip* run = find(*lib, "cmu_09_11_run");
+  ASSERT_TRUE(walk && run);
+  EXPECT_NEAR(walk->speed_m_s, 1.36f, 0.05f * 1.36f);
+  EXPECT_NEAR(run->speed_m_s, 3.50f * ratio, 0.05f * 3.50f * ratio);
+  // No idle clip in the pair: a standing pose is made from the walk, with both feet down.
+  ASSERT_GE(lib->idle, 0);
+  EXPECT_FALSE(lib->clips[lib->idle].gait);
+  EXPECT_NE(lib->clips[lib->idle].clip.name.find("cmu_07_01_walk"), std::string::npos);
+}
+
+TEST(LocomotionLibrary, MannequinGlbKeepsLocomotionAndItsIdle) {
+  GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
+  auto set = load_clip_file(test::data_path("clips/gltf/ual_mannequin_quaternius.glb"));
+  ASSERT_TRUE(set.ok()) << set.message();
+  std::vector<ClipSet> sets{std::move(*set)};
+  auto lib = build_locomotion_library(sets);
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  EXPECT_EQ(lib->clips[lib->idle].clip.name, "Idle_Loop");
+  EXPECT_NE(find(*lib, "Walk_Loop"), nullptr);
+  for (const LocomotionClip& c : lib->clips) {
+    const std::string n = c.clip.name;
+    EXPECT_EQ(n.find("Crouch"), std::string::npos) << n;
+    EXPECT_EQ(n.find("Swim"), std::string::npos) << n;
+    EXPECT_EQ(n.find("Driving"), std::string::npos) << n;
+  }
+  EXPECT_EQ(lib->skeleton->num_joints(), 53);
+  ASSERT_TRUE(lib->mesh);  // the glb's own skinned mesh is kept for the renderer
+}
+
+}  // namespace
+}  // namespace gk
