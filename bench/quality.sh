@@ -58,10 +58,10 @@ for run in "${runs[@]}"; do
         continue
       fi
       slide[$mode]=$(jq '.metrics.foot_slide_cm_s // 0' "$json")
-      jq -r --arg n "$name" --arg s "$sim" --arg c "$cs" --arg m "$mode" '
+      jq -r --arg n "$name" --arg s "$sim" --arg c "$cs" --arg mo "$mode" '
         def f(x; d): if x == null then "n/a" else (x * pow(10; d) | round / pow(10; d) | tostring) end;
         .metrics as $m |
-        "| \($n) | \($s) | \($c) | \($m) | \(f($m.foot_slide_cm_s; 2)) (\(f($m.foot_slide_floor_cm_s; 2))) | \(f($m.skate_ratio; 4)) | \(f($m.torsion_deg.max; 1)) | \(f($m.facing_error_deg.p95; 1)) | \(f($m.heading_error_deg.p95; 1)) | \(f($m.root_error_cm.mean; 2))/\(f($m.root_error_cm.max; 2)) | \(f($m.playback_rate.outside_limits; 4)) | \($m.pop_count) |"' \
+        "| \($n) | \($s) | \($c) | \($mo) | \(f($m.foot_slide_cm_s; 2)) (\(f($m.foot_slide_floor_cm_s; 2))) | \(f($m.skate_ratio; 4)) | \(f($m.torsion_deg.max; 1)) | \(f($m.facing_error_deg.p95; 1)) | \(f($m.heading_error_deg.p95; 1)) | \(f($m.root_error_cm.mean; 2))/\(f($m.root_error_cm.max; 2)) | \(f($m.playback_rate.outside_limits; 4)) | \($m.pop_count) |"' \
         "$json" | tr -d '\n' >> "$out.tmp"
       if [[ $mode == apm ]]; then
         awk -v n="${slide[naive]:-0}" -v a="${slide[apm]}" 'BEGIN { if (a > 0) printf " %.1fx |\n", n / a; else print " n/a |" }' >> "$out.tmp"

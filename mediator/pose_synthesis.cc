@@ -41,7 +41,12 @@ constexpr float kHoldAnkle = 0.09f;
 // A free foot moving faster than kPlantSpeed low over the ground is lifted to this clearance so it
 // swings instead of dragging; fully from kClearSpeed on.
 constexpr float kClearance = 0.035f;
-constexpr float kClearSpeed = 0.9f;  // [m/s]
+constexpr float kClearSpeed = 0.6f;  // [m/s]
+// The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
+// kMaxDrop, and comes back up at kDropRecovery.
+constexpr float kDropReach = 0.99f;
+constexpr float kMaxDrop = 0.08f;          // [m]
+constexpr float kDropRecovery = 0.25f;     // [m/s]
 
 float smoothstep01(float x) {
   x = std::clamp(x, 0.0f, 1.0f);
@@ -82,6 +87,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   pelvis_heading_.assign(capacity, 0.0f);
   upper_heading_.assign(capacity, 0.0f);
   has_prev_.assign(capacity, 0);
+  drop_.assign(capacity, 0.0f);
   locks_.state.assign(capacity * 2, static_cast<uint8_t>(FootLockState::kFree));
   locks_.target.assign(capacity * 2, glm::vec3(0.0f));
   locks_.from.assign(capacity * 2, glm::vec3(0.0f));
@@ -195,18 +201,19 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
   const MediatorParams& P = m.params();
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   glm::quat ankle_world_rot[2];
-  bool any = false;
+  glm::vec3 toe_offset[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
+  bool use_ik[2] = {false, false}, pinned[2] = {false, false};
   for (int side = 0; side < 2; ++side) {
     const Side sd = static_cast<Side>(side);
-    const int hip = skeleton_.hip(sd), knee = skeleton_.knee(sd), ankle = skeleton_.ankle(sd),
-              toe = skeleton_.toe(sd);
+    const int ankle = skeleton_.ankle(sd), toe = skeleton_.toe(sd);
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     const glm::vec3 anim_toe = translation_of(world_[base + toe]);
     const glm::vec3 anim_ankle = translation_of(world_[base + ankle]);
     // Contact from the animated foot itself (after blending, placing and twisting), not from the
     // clips' labels: a blend of a standing and a walking clip has feet of its own.
-    const float toe_h = anim_toe.y - library_.toe_floor_m[side];
-    const float ankle_h = anim_ankle.y - library_.ankle_floor_m[side];
+    // Heights as drawn: the body is still lowered by last frame's pelvis drop.
+    const float toe_h = anim_toe.y - drop_[slot] - library_.toe_floor_m[side];
+    const float ankle_h = anim_ankle.y - drop_[slot] - library_.ankle_floor_m[side];
     const glm::vec3 prev = locks_.anim_toe[k];
     locks_.anim_toe[k] = anim_toe;
     const float ground_speed =
@@ -286,22 +293,61 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
         break;
       }
     }
-    ankle_world_rot[side] = rotation_of(world_[base + ankle]);
     // A free foot skimming the ground fast is lifted clear (continuous in height and speed).
     float lift = 0.0f;
     if (state == FootLockState::kFree && ankle_h <= kHoldAnkle) {
       const float fast = smoothstep01((ground_speed - kPlantSpeed) / (kClearSpeed - kPlantSpeed));
       lift = std::max(0.0f, kClearance - toe_h) * fast;
     }
-    if (weight <= 0.0f && lift <= 0.0f) continue;
+    use_ik[side] = weight > 0.0f || lift > 0.0f;
+    // Where the toe must go, relative to the animated foot (the ankle moves by the same offset).
+    toe_offset[side] = glm::mix(anim_toe, target, weight) + glm::vec3(0.0f, lift, 0.0f) - anim_toe;
+    pinned[side] = weight > 0.0f;
+  }
+  if (!use_ik[0] && !use_ik[1]) {
+    drop_[slot] = 0.0f;
+    return;
+  }
+  // Pelvis drop: a pinned foot the leg cannot reach pulls the whole body down (up to kMaxDrop)
+  // rather than sliding; the drop eases back at kDropRecovery.
+  float needed = 0.0f;
+  for (int side = 0; side < 2; ++side) {
+    if (!pinned[side]) continue;
+    const Side sd = static_cast<Side>(side);
+    const glm::vec3 goal = translation_of(world_[base + skeleton_.ankle(sd)]) + toe_offset[side];
+    const glm::vec3 hip_p = translation_of(world_[base + skeleton_.hip(sd)]);
+    const float reach = kDropReach * library_.leg_length_m[side];
+    const float dx = std::hypot(goal.x - hip_p.x, goal.z - hip_p.z), dy = hip_p.y - goal.y;
+    if (dx < reach && dy > 0.0f) needed = std::max(needed, dy - std::sqrt(reach * reach - dx * dx));
+  }
+  float drop = std::max(needed, drop_[slot] - kDropRecovery * dt);
+  drop = std::clamp(drop, 0.0f, kMaxDrop);
+  drop_[slot] = drop;
+  glm::mat4 placed = root;
+  if (drop > 0.0f) {
+    placed[3].y -= drop;
+    fk_from(slot, 0, placed);
+    // Free feet go down with the body; pinned ones stay where they are pinned.
+    for (int side = 0; side < 2; ++side) {
+      if (pinned[side]) toe_offset[side].y += drop;
+    }
+  }
+  for (int side = 0; side < 2; ++side) {
+    const Side sd = static_cast<Side>(side);
+    const int hip = skeleton_.hip(sd), knee = skeleton_.knee(sd), ankle = skeleton_.ankle(sd);
+    const size_t k = static_cast<size_t>(slot) * 2 + side;
+    ankle_world_rot[side] = rotation_of(world_[base + ankle]);
+    if (!use_ik[side]) continue;
     // IK: move the ankle by the toe's offset, keep the foot's world orientation.
-    const glm::vec3 goal_toe = glm::mix(anim_toe, target, weight) + glm::vec3(0.0f, lift, 0.0f);
-    const glm::vec3 goal_ankle = anim_ankle + (goal_toe - anim_toe);
+    const glm::vec3 anim_ankle = translation_of(world_[base + ankle]);
+    const glm::vec3 goal_ankle = anim_ankle + toe_offset[side];
     const glm::vec3 hip_p = translation_of(world_[base + hip]);
     const float reach = glm::length(goal_ankle - hip_p);
-    if (reach > P.max_leg_stretch * library_.leg_length_m[side] && state == FootLockState::kLocked) {
-      state = FootLockState::kReleasing;  // overstretched: let the foot go, smoothly
-      locks_.from[k] = target;
+    if (reach > P.max_leg_stretch * library_.leg_length_m[side] &&
+        locks_.state[k] == static_cast<uint8_t>(FootLockState::kLocked)) {
+      // Overstretched even with the pelvis down: let the foot go, smoothly.
+      locks_.state[k] = static_cast<uint8_t>(FootLockState::kReleasing);
+      locks_.from[k] = locks_.target[k];
       locks_.timer[k] = 0.0f;
     }
     const glm::vec3 knee_p = translation_of(world_[base + knee]);
@@ -320,10 +366,8 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     ik.run();
     local_rot_[base + hip] = glm::normalize(local_rot_[base + hip] * c_hip);
     local_rot_[base + knee] = glm::normalize(local_rot_[base + knee] * c_knee);
-    any = true;
   }
-  if (!any) return;
-  fk_from(slot, first_leg_joint_, root);
+  fk_from(slot, first_leg_joint_, placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet.
   for (int side = 0; side < 2; ++side) {
     const Side sd = static_cast<Side>(side);
@@ -333,7 +377,7 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
     local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
   }
-  fk_from(slot, std::min(skeleton_.ankle(Side::kLeft), skeleton_.ankle(Side::kRight)), root);
+  fk_from(slot, std::min(skeleton_.ankle(Side::kLeft), skeleton_.ankle(Side::kRight)), placed);
 }
 
 }  // namespace gk

@@ -79,6 +79,7 @@ class PoseSynthesizer {
   std::vector<float> pelvis_heading_;
   std::vector<float> upper_heading_;
   std::vector<uint8_t> has_prev_;
+  std::vector<float> drop_;  // pelvis drop per slot [m]
   FootLocks locks_;
   int first_leg_joint_ = 0;
   int first_spine_joint_ = 0;
