@@ -142,7 +142,8 @@ std::string summary(const BenchReport& r) {
          num(m["foot_drift_cm_per_step"], 2) + " cm/step\n";
     s += "  torsion mean/p95/max " + num(m["torsion_deg"]["mean"], 1) + "/" +
          num(m["torsion_deg"]["p95"], 1) + "/" + num(m["torsion_deg"]["max"], 1) +
-         " deg; facing error p95 " + num(m["facing_error_deg"]["p95"], 1) +
+         " deg; facing error p95 " + num(m["facing_error_deg"]["p95"], 1) + " (within limit " +
+         num(m["facing_error_deg"]["within_limit_p95"], 1) + ")" +
          " deg; heading error p95 " + num(m["heading_error_deg"]["p95"], 1) + " deg\n";
     s += "  root error mean/max " + num(m["root_error_cm"]["mean"], 2) + "/" +
          num(m["root_error_cm"]["max"], 2) + " cm; playback rate " +
@@ -181,7 +182,11 @@ nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& 
         {"max", or_null(m.torsion_deg, m.torsion_deg.max)}}},
       {"facing_error_deg",
        {{"mean", or_null(m.facing_error_deg, m.facing_error_deg.mean)},
-        {"p95", or_null(m.facing_error_deg, m.facing_error_deg.p95)}}},
+        {"p95", or_null(m.facing_error_deg, m.facing_error_deg.p95)},
+        {"within_limit_mean",
+         or_null(m.facing_error_within_limit_deg, m.facing_error_within_limit_deg.mean)},
+        {"within_limit_p95",
+         or_null(m.facing_error_within_limit_deg, m.facing_error_within_limit_deg.p95)}}},
       {"heading_error_deg",
        {{"mean", or_null(m.heading_error_deg, m.heading_error_deg.mean)},
         {"p95", or_null(m.heading_error_deg, m.heading_error_deg.p95)}}},

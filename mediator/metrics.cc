@@ -38,6 +38,7 @@ MetricsRecorder::MetricsRecorder(const LocomotionLibrary& library, float frame_t
   const size_t n = capacity * frames_hint;
   torsion_.reserve(n);
   facing_.reserve(n);
+  facing_within_.reserve(n);
   heading_.reserve(n);
   root_error_.reserve(n);
   rate_.reserve(n);
@@ -80,7 +81,10 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m, const P
 
     torsion_.push_back(std::abs(poses.torsion(slot)) * kDeg);
     if (std::isfinite(frame.thetas[i])) {
-      facing_.push_back(std::abs(wrap_pi(poses.upper_heading(slot) - frame.thetas[i])) * kDeg);
+      const float err = std::abs(wrap_pi(poses.upper_heading(slot) - frame.thetas[i])) * kDeg;
+      facing_.push_back(err);
+      const float asked = std::abs(wrap_pi(frame.thetas[i] - poses.pelvis_heading(slot))) * kDeg;
+      if (asked <= P.torsion_limit_deg) facing_within_.push_back(err);
     }
     root_error_.push_back(100.0f * glm::length(root - frame.positions[i]));
     if (continues) {
@@ -125,6 +129,7 @@ MetricsReport MetricsRecorder::finish() const {
   auto copy_summary = [](std::vector<float> v) { return summarize(v); };
   r.torsion_deg = copy_summary(torsion_);
   r.facing_error_deg = copy_summary(facing_);
+  r.facing_error_within_limit_deg = copy_summary(facing_within_);
   r.heading_error_deg = copy_summary(heading_);
   r.root_error_cm = copy_summary(root_error_);
   r.playback_rate = copy_summary(rate_);

@@ -25,6 +25,9 @@ struct Summary {
 struct MetricsReport {
   SlideStats slide;
   Summary torsion_deg, facing_error_deg, heading_error_deg, root_error_cm, playback_rate;
+  // Facing error over the agent-frames whose asked twist (theta against the pelvis) is within the
+  // torsion limit: what the upper body could have reached.
+  Summary facing_error_within_limit_deg;
   double playback_outside_limits = 0.0;  // fraction of agent-frames
   std::optional<double> feedback_speed_change;  // null when the mediator never changed v
   int64_t pop_count = 0;
@@ -56,7 +59,8 @@ class MetricsRecorder {
   int frame_ = 0;
   std::unordered_map<uint32_t, Track> tracks_;
   std::vector<Track> finished_;
-  std::vector<float> torsion_, facing_, heading_, root_error_, rate_, feedback_change_;
+  std::vector<float> torsion_, facing_, facing_within_, heading_, root_error_, rate_,
+      feedback_change_;
   int64_t rate_outside_ = 0;
   int64_t pops_ = 0;
   int64_t agent_frames_ = 0;
