@@ -14,6 +14,8 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kAbsurdSpeed = 15.0f;  // [m/s] faster simulator velocities are treated as errors
+constexpr float kRootPullTime = 0.1f;   // [s] how fast the rendered root is pulled onto p
+constexpr float kMaxRootOffset = 0.06f; // [m] the rendered root never strays further from p
 constexpr float kSwitchHysteresis = 0.26f;  // [rad] a new travel direction group must be this much better
 
 bool finite2(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
@@ -393,7 +395,19 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     }
   }
 
-  pl.root_xz[slot] = p;
+  // 8. The root follows p: predicted with the filtered velocity and pulled onto p, so a simulator's
+  // frame-to-frame jitter (velocity flips in a jam) does not shake the body, while a steady walk
+  // is tracked without lag. Never more than kMaxRootOffset from p.
+  if (apm && !pl.fresh[slot]) {
+    const glm::vec2 predicted = pl.root_xz[slot] + vel * dt;
+    glm::vec2 root = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
+    const glm::vec2 off = root - p;
+    const float len = glm::length(off);
+    if (len > kMaxRootOffset) root = p + off * (kMaxRootOffset / len);
+    pl.root_xz[slot] = root;
+  } else {
+    pl.root_xz[slot] = p;
+  }
   pl.lower_yaw[slot] = psi;
   pl.upper_yaw[slot] = apm ? theta : psi;
   pl.travel_yaw[slot] = wrap_pi(psi + (gait_w > 0.0f ? std::atan2(dir_sum.x, dir_sum.y) : 0.0f));
