@@ -1,0 +1,104 @@
+// The quality bounds on a representative subset of bench/quality.sh, small enough for CI:
+// real crowd sources (social forces on shipped scenarios, a replayed real trajectory file) through
+// the mediator and pose synthesis, measured with the METRICS.md definitions.
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "animation/clip_library.h"
+#include "crowd/scenario.h"
+#include "crowd/social_forces.h"
+#include "crowd/trajectory_replay.h"
+#include "tests/mediator/mediator_fixture.h"
+#include "tests/test_data.h"
+
+namespace gk {
+namespace {
+
+constexpr float kDt = 1.0f / 60.0f;
+constexpr int kFrames = 600;
+
+MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, MediatorMode mode) {
+  MediatorParams params;
+  params.mode = mode;
+  Mediator mediator(lib, params, crowd.capacity());
+  PoseSynthesizer poses(lib, crowd.capacity(), false);
+  MetricsRecorder metrics(lib, kDt, crowd.capacity(), kFrames);
+  for (int f = 0; f < kFrames; ++f) {
+    EXPECT_TRUE(crowd.step(kDt).ok());
+    const AgentFrame frame = crowd.frame();
+    EXPECT_TRUE(mediator.plan(frame, kDt).ok());
+    poses.run(mediator, kDt);
+    metrics.record(frame, mediator, poses);
+    EXPECT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
+  }
+  return metrics.finish();
+}
+
+std::unique_ptr<CrowdSource> scenario_crowd(const std::string& name) {
+  auto loaded = load_scenario_by_name(name, scenario_dir());
+  EXPECT_TRUE(loaded.ok()) << loaded.message();
+  const int n = loaded->default_agents;
+  const Scenario s = scale_scenario(*loaded, n);
+  auto agents = expand_agents(s, n, 1);
+  EXPECT_TRUE(agents.ok()) << agents.message();
+  auto sim = SocialForces::create(s, *agents, SocialForceParams{});
+  EXPECT_TRUE(sim.ok()) << sim.message();
+  return std::move(*sim);
+}
+
+void expect_apm_bounds(const MetricsReport& apm, const MetricsReport& naive, bool replay,
+                       const std::string& what) {
+  const MediatorParams defaults;
+  EXPECT_LE(apm.slide.mean_cm_s, 2.0f) << what;
+  EXPECT_LE(apm.slide.skate_ratio, 0.005f) << what;
+  EXPECT_LE(apm.torsion_deg.max, defaults.torsion_limit_deg + 0.5) << what;
+  EXPECT_EQ(apm.playback_outside_limits, 0.0) << what;
+  EXPECT_EQ(apm.pop_count, 0) << what;
+  EXPECT_LE(apm.heading_error_deg.p95, 15.0) << what;
+  EXPECT_LE(apm.root_error_cm.mean, replay ? 4.0 : 3.0) << what;
+  if (!replay) {
+    EXPECT_LE(apm.root_error_cm.max, 10.0) << what;
+  }
+  // The problem is real: the naive crowd skates at least ten times as much.
+  EXPECT_GE(naive.slide.mean_cm_s, 10.0f * apm.slide.mean_cm_s) << what;
+  EXPECT_GT(apm.slide.num_samples, 1000) << what;
+}
+
+TEST(Quality, CorridorOnSocialForcesWithBuiltinClips) {
+  const LocomotionLibrary& lib = test::builtin_library();
+  auto a = scenario_crowd("corridor");
+  auto b = scenario_crowd("corridor");
+  expect_apm_bounds(run_source(*a, lib, MediatorMode::kApm),
+                    run_source(*b, lib, MediatorMode::kNaive), false, "corridor");
+}
+
+TEST(Quality, GalleryUpperBodyFacesTheExhibits) {
+  const LocomotionLibrary& lib = test::builtin_library();
+  auto a = scenario_crowd("gallery");
+  auto b = scenario_crowd("gallery");
+  const MetricsReport apm = run_source(*a, lib, MediatorMode::kApm);
+  expect_apm_bounds(apm, run_source(*b, lib, MediatorMode::kNaive), false, "gallery");
+  ASSERT_GT(apm.facing_error_within_limit_deg.count, 1000u);
+  EXPECT_LE(apm.facing_error_within_limit_deg.p95, 10.0);
+}
+
+TEST(Quality, ReplayedPedestriansWithTheMannequinClips) {
+  GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
+  GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
+  auto set = load_clip_file(test::data_path("clips/gltf/ual_mannequin_quaternius.glb"));
+  ASSERT_TRUE(set.ok()) << set.message();
+  std::vector<ClipSet> sets{std::move(*set)};
+  auto lib = build_locomotion_library(sets);
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  auto a = load_trajectory_replay(test::data_path("trajectories/zara1/crowds_zara01.txt"));
+  auto b = load_trajectory_replay(test::data_path("trajectories/zara1/crowds_zara01.txt"));
+  ASSERT_TRUE(a.ok() && b.ok());
+  const MetricsReport apm = run_source(**a, *lib, MediatorMode::kApm);
+  expect_apm_bounds(apm, run_source(**b, *lib, MediatorMode::kNaive), true, "zara01 mannequin");
+  EXPECT_FALSE(apm.feedback_speed_change.has_value());  // replay ignores feedback: none is asked
+}
+
+}  // namespace
+}  // namespace gk
