@@ -94,20 +94,23 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.weight.assign(capacity * 2, 0.0f);
   locks_.timer.assign(capacity * 2, 0.0f);
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
-  first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
-  first_spine_joint_ = skeleton_.spine_chain.empty() ? num_joints_ : skeleton_.spine_chain.front();
-}
-
-void PoseSynthesizer::run(const Mediator& m, float dt_s) {
-  const AnimationPlans& pl = m.plans();
-  const size_t n = m.num_agents();
-  const size_t J = num_joints_;
-  tbb::enumerable_thread_specific<Scratch> scratch([J] {
+  // Per-thread sampling scratch, made once per worker thread on first use and kept.
+  scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J] {
     Scratch s;
     s.rot.resize(kMaxBlendLayers * J);
     s.trans.resize(kMaxBlendLayers * J);
     return s;
   });
+  first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
+  first_spine_joint_ = skeleton_.spine_chain.empty() ? num_joints_ : skeleton_.spine_chain.front();
+}
+
+PoseSynthesizer::~PoseSynthesizer() = default;
+
+void PoseSynthesizer::run(const Mediator& m, float dt_s) {
+  const AnimationPlans& pl = m.plans();
+  const size_t n = m.num_agents();
+  tbb::enumerable_thread_specific<Scratch>& scratch = *scratch_;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 32), [&](const tbb::blocked_range<size_t>& r) {
     Scratch& s = scratch.local();
     for (size_t i = r.begin(); i < r.end(); ++i) synthesize_agent(m, pl.slot_of_agent[i], dt_s, s);

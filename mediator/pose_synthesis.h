@@ -5,11 +5,13 @@
 // skinning palettes. Parallel over agents; all buffers sized at construction.
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
+#include <tbb/enumerable_thread_specific.h>
 
 #include "mediator/locomotion_library.h"
 #include "mediator/mediator.h"
@@ -30,6 +32,7 @@ struct FootLocks {
 class PoseSynthesizer {
  public:
   PoseSynthesizer(const LocomotionLibrary& library, size_t capacity, bool make_palettes);
+  ~PoseSynthesizer();
 
   // Synthesises every live agent of the mediator's last plan.
   void run(const Mediator& mediator, float dt_s);
@@ -81,6 +84,7 @@ class PoseSynthesizer {
   std::vector<uint8_t> has_prev_;
   std::vector<float> drop_;  // pelvis drop per slot [m]
   FootLocks locks_;
+  std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   int first_leg_joint_ = 0;
   int first_spine_joint_ = 0;
 };
