@@ -241,7 +241,9 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
       d.y = 0.0f;
       if (glm::length(d) > th.max_speed_m_s) contact[s][f] = 0;
     }
-    filter_runs(contact[s], std::max(2, static_cast<int>(std::lround(th.min_duration_s * clip.fps))), clip.loops);
+    filter_runs(contact[s],
+                std::max(2, static_cast<int>(std::lround(th.min_duration_s * clip.fps))),
+                clip.loops);
     a.contacts[s] = to_intervals(contact[s], clip.fps, clip.loops);
   }
 

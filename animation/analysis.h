@@ -35,16 +35,16 @@ struct ClipAnalysis {
   float fps = 0.0f;
   int num_frames = 0;
   float duration_s = 0.0f;
-  bool in_place = false;         // no horizontal root motion: speed inferred from the stance foot
+  bool in_place = false;  // no horizontal root motion: speed inferred from the stance foot
   float native_speed_m_s = 0.0f;
-  float direction_rad = 0.0f;    // travel direction relative to the character's facing (0 = forward)
-  TimeInterval cycle;            // one gait cycle (loop points)
+  float direction_rad = 0.0f;  // travel direction relative to the character's facing (0 = forward)
+  TimeInterval cycle;          // one gait cycle (loop points)
   std::vector<TimeInterval> contacts[2];  // [Side] foot contact intervals, in clip time
   // Per frame: gait phase in [0, 1), 0 at the left foot's contact start (linear between contacts).
   std::vector<float> phase;
-  SlideStats floor;              // foot-slide metrics of the clip played with its own root motion
-  // Ground under the feet, fitted to the lowest toe heights: y = ground_y0_m + ground_slope_m_s * t.
-  // Mocap floors are rarely level (the CMU walk rises 5 cm over 2.6 s); contacts are measured
+  SlideStats floor;  // foot-slide metrics of the clip played with its own root motion
+  // Ground under the feet, fitted to the lowest toe heights: y = ground_y0_m + ground_slope_m_s *
+  // t. Mocap floors are rarely level (the CMU walk rises 5 cm over 2.6 s); contacts are measured
   // against this line rather than one global minimum.
   float ground_y0_m = 0.0f;
   float ground_slope_m_s = 0.0f;

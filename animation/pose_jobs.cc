@@ -9,7 +9,8 @@
 namespace gk {
 namespace {
 
-// nlerp on the shortest arc: cheaper than slerp and, between neighbouring frames, indistinguishable.
+// nlerp on the shortest arc: cheaper than slerp and, between neighbouring frames,
+// indistinguishable.
 glm::quat nlerp_shortest(const glm::quat& a, const glm::quat& b, float t) {
   const float sign = glm::dot(a, b) < 0.0f ? -1.0f : 1.0f;
   const glm::quat q = a * (1.0f - t) + (b * sign) * t;
@@ -183,8 +184,10 @@ void TwoBoneIKJob::run() const {
   const glm::vec3 ac_n = ac / lac;
   const float ac_ab_0 = std::acos(clamp_unit(glm::dot(ac_n, ab)));
   const float ba_bc_0 = std::acos(clamp_unit(glm::dot(-ab, bc)));
-  const float ac_ab_1 = std::acos(clamp_unit((lcb * lcb - lab * lab - lat * lat) / (-2.0f * lab * lat)));
-  const float ba_bc_1 = std::acos(clamp_unit((lat * lat - lab * lab - lcb * lcb) / (-2.0f * lab * lcb)));
+  const float ac_ab_1 =
+      std::acos(clamp_unit((lcb * lcb - lab * lab - lat * lat) / (-2.0f * lab * lat)));
+  const float ba_bc_1 =
+      std::acos(clamp_unit((lat * lat - lab * lab - lcb * lcb) / (-2.0f * lab * lcb)));
 
   // Bend plane normal: the current plane of the limb, or the pole plane when the limb is straight.
   glm::vec3 axis0 = glm::cross(ac_n, ab);
@@ -205,7 +208,8 @@ void TwoBoneIKJob::run() const {
   const glm::vec3 knee_p = knee - axis_t * glm::dot(knee, axis_t);
   const glm::vec3 pole_p = pole - axis_t * glm::dot(pole, axis_t);
   if (glm::length(knee_p) > 1e-5f && glm::length(pole_p) > 1e-5f) {
-    const float twist = std::atan2(glm::dot(glm::cross(knee_p, pole_p), axis_t), glm::dot(knee_p, pole_p));
+    const float twist =
+        std::atan2(glm::dot(glm::cross(knee_p, pole_p), axis_t), glm::dot(knee_p, pole_p));
     r = glm::angleAxis(twist, axis_t) * r;
   }
 

@@ -17,12 +17,12 @@ namespace gk {
 // Samples a clip at time_s with linear interpolation of translations and normalised lerp of
 // rotations (shortest arc). Looping clips wrap time; others clamp it to [0, duration]. Between the
 // last frame of a loop and its first, the root joint (joint 0) keeps its mean horizontal velocity
-// instead of jumping back, so root motion stays continuous within one loop; callers that chain loops
-// add one loop's displacement per wrap.
+// instead of jumping back, so root motion stays continuous within one loop; callers that chain
+// loops add one loop's displacement per wrap.
 struct SampleClipJob {
   const Clip* clip = nullptr;
   float time_s = 0.0f;
-  std::span<glm::quat> out_rotations;    // num_joints
+  std::span<glm::quat> out_rotations;     // num_joints
   std::span<glm::vec3> out_translations;  // num_joints
   bool validate() const;
   void run() const;
@@ -61,7 +61,8 @@ struct LocalToModelJob {
 // Analytic two-bone IK (hip-knee-ankle). Given the model-space transforms of the start, mid and
 // end joints, finds local rotation corrections so that the end joint reaches target (or gets as
 // close as the limb allows), with the mid joint bending toward pole. Apply them as
-//   local[start] = local[start] * out_start_correction; local[mid] = local[mid] * out_mid_correction
+//   local[start] = local[start] * out_start_correction; local[mid] = local[mid] *
+//   out_mid_correction
 // and recompute FK below the start joint.
 struct TwoBoneIKJob {
   glm::mat4 start_model{1.0f};

@@ -27,7 +27,8 @@ class [[nodiscard]] Status {
     return Error(file + ": " + what);
   }
   // "file: field: what" for structured formats (JSON, glTF).
-  static Status AtField(const std::string& file, const std::string& field, const std::string& what) {
+  static Status AtField(const std::string& file, const std::string& field,
+                        const std::string& what) {
     return Error(file + ": " + field + ": " + what);
   }
 
@@ -84,8 +85,8 @@ const Status& StatusOf(const Result<T>& r) {
 }  // namespace gk
 
 // Propagate a failed Status/Result from a function returning Status or Result<U>.
-#define GK_RETURN_IF_ERROR(expr)                                \
-  do {                                                          \
-    const auto& gk_status_or_ = (expr);                         \
+#define GK_RETURN_IF_ERROR(expr)                                   \
+  do {                                                             \
+    const auto& gk_status_or_ = (expr);                            \
     if (!gk_status_or_.ok()) return ::gk::StatusOf(gk_status_or_); \
   } while (0)

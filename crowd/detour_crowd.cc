@@ -278,7 +278,8 @@ void DetourCrowdSource::advance_waypoints() {
       // The end of the chain: agents that leave the scene (an exit) vanish there.
       const float* goal = &waypoint_pos_[3 * w];
       const float gx = ag->npos[0] - goal[0], gz = ag->npos[2] - goal[2];
-      // At least kWaypointReached_m: a crowd cannot all reach one point, the last ones would pile up.
+      // At least kWaypointReached_m: a crowd cannot all reach one point, the last ones would pile
+      // up.
       const float r = std::max(goal_radius_[i], kWaypointReached_m);
       if (remove_at_goal_[i] && gx * gx + gz * gz <= r * r) {
         crowd_->removeAgent(static_cast<int>(i));

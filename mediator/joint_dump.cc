@@ -26,8 +26,8 @@ Result<JointDumpWriter> JointDumpWriter::open(const std::string& path, const Ske
       if (j < 0) {
         std::string known;
         for (const std::string& k : skeleton.names) known += (known.empty() ? "" : ", ") + k;
-        return Status::Error("--dump-joint-names: no joint '" + n + "' in the skeleton (joints: " +
-                             known + ")");
+        return Status::Error("--dump-joint-names: no joint '" + n +
+                             "' in the skeleton (joints: " + known + ")");
       }
       joints.push_back(j);
       used.push_back(n);
@@ -40,7 +40,9 @@ Result<JointDumpWriter> JointDumpWriter::open(const std::string& path, const Ske
 }
 
 JointDumpWriter::JointDumpWriter(JointDumpWriter&& o) noexcept
-    : file_(o.file_), path_(std::move(o.path_)), joints_(std::move(o.joints_)),
+    : file_(o.file_),
+      path_(std::move(o.path_)),
+      joints_(std::move(o.joints_)),
       names_(std::move(o.names_)) {
   o.file_ = nullptr;
 }

@@ -1,8 +1,8 @@
 #pragma once
-// The per-frame joint dump of METRICS.md: final world-space positions of named joints of every agent
-// on every frame, exactly as rendered, as CSV `frame,time_s,agent,joint,x,y,z`. Floats are written
-// with 9 significant digits, enough to reproduce each value exactly, so a metric recomputed from the
-// file equals the one in the JSON report.
+// The per-frame joint dump of METRICS.md: final world-space positions of named joints of every
+// agent on every frame, exactly as rendered, as CSV `frame,time_s,agent,joint,x,y,z`. Floats are
+// written with 9 significant digits, enough to reproduce each value exactly, so a metric recomputed
+// from the file equals the one in the JSON report.
 
 #include <cstdio>
 #include <string>

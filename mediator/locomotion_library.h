@@ -18,13 +18,13 @@ namespace gk {
 inline constexpr int kPhaseTableSize = 64;
 
 struct LocomotionClip {
-  Clip clip;               // in place, facing +z, on the library skeleton
-  ClipAnalysis analysis;   // of the original (retargeted) clip
-  float speed_m_s = 0.0f;  // native ground speed
+  Clip clip;                   // in place, facing +z, on the library skeleton
+  ClipAnalysis analysis;       // of the original (retargeted) clip
+  float speed_m_s = 0.0f;      // native ground speed
   float direction_rad = 0.0f;  // travel direction relative to facing (0 forward, +pi/2 left)
-  bool gait = false;       // has a gait cycle (alternating contacts) and travels
+  bool gait = false;           // has a gait cycle (alternating contacts) and travels
   float cycle_start_s = 0.0f;
-  float cycle_s = 1.0f;    // duration of one gait cycle (stride) in clip time
+  float cycle_s = 1.0f;  // duration of one gait cycle (stride) in clip time
   // Clip time [s] at phase k / kPhaseTableSize over one cycle (monotone, may exceed the duration of
   // a looping clip; sampling wraps).
   float phase_to_time[kPhaseTableSize + 1] = {};
@@ -33,9 +33,9 @@ struct LocomotionClip {
   // where an existing lock is kept (the foot has not clearly lifted yet).
   std::vector<uint8_t> plant[2];
   std::vector<uint8_t> hold[2];
-  std::vector<float> toe_height_m[2];  // toe height above its lowest point
-  float toe_floor_m[2] = {0.0f, 0.0f};    // lowest toe height in the clip
-  float ankle_floor_m[2] = {0.0f, 0.0f};  // lowest ankle height in the clip
+  std::vector<float> toe_height_m[2];      // toe height above its lowest point
+  float toe_floor_m[2] = {0.0f, 0.0f};     // lowest toe height in the clip
+  float ankle_floor_m[2] = {0.0f, 0.0f};   // lowest ankle height in the clip
   float time_at_phase(float phase) const;  // phase in [0, 1)
 };
 

@@ -13,17 +13,18 @@ namespace gk {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-constexpr float kAbsurdSpeed = 15.0f;  // [m/s] faster simulator velocities are treated as errors
-constexpr float kRootPullTime = 0.1f;   // [s] how fast the rendered root is pulled onto p
-constexpr float kMaxRootOffset = 0.06f; // [m] the rendered root never strays further from p
-constexpr float kSwitchHysteresis = 0.26f;  // [rad] a new travel direction group must be this much better
+constexpr float kAbsurdSpeed = 15.0f;    // [m/s] faster simulator velocities are treated as errors
+constexpr float kRootPullTime = 0.1f;    // [s] how fast the rendered root is pulled onto p
+constexpr float kMaxRootOffset = 0.06f;  // [m] the rendered root never strays further from p
+constexpr float kSwitchHysteresis =
+    0.26f;  // [rad] a new travel direction group must be this much better
 
 bool finite2(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 float heading2(const glm::vec2& v) { return std::atan2(v.x, v.y); }
 
 // Speed bracket within one direction group, with the standing clip at speed 0 below it.
-void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, float speed, float share,
-                       float* w) {
+void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, float speed,
+                       float share, float* w) {
   if (share <= 0.0f) return;
   const std::vector<int>& c = g.clips;
   const float first = lib.clips[c.front()].speed_m_s;
@@ -92,7 +93,8 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   dominant_.assign(capacity, static_cast<int16_t>(library.idle));
 }
 
-void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta) {
+void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v,
+                         float theta) {
   slot_id_[slot] = id;
   const glm::vec2 vel = finite2(v) && glm::length(v) < kAbsurdSpeed ? v : glm::vec2(0.0f);
   const float th = std::isfinite(theta) ? theta : heading2(vel);
@@ -187,7 +189,8 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s) {
     const int32_t slot = ids_.find(id);
     plans_.slot_of_agent[i] = slot;
     if (slot < 0) continue;
-    if (seen_[slot]) return Status::Error("mediator: agent id " + std::to_string(id) + " appears twice");
+    if (seen_[slot])
+      return Status::Error("mediator: agent id " + std::to_string(id) + " appears twice");
     seen_[slot] = 1;
   }
   std::fill(plans_.agent_of_slot.begin(), plans_.agent_of_slot.end(), -1);
@@ -209,7 +212,8 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s) {
     init_slot(slot, frame.ids[i], frame.positions[i], frame.velocities[i], frame.thetas[i]);
     plans_.slot_of_agent[i] = slot;
   }
-  for (size_t i = 0; i < n; ++i) plans_.agent_of_slot[plans_.slot_of_agent[i]] = static_cast<int32_t>(i);
+  for (size_t i = 0; i < n; ++i)
+    plans_.agent_of_slot[plans_.slot_of_agent[i]] = static_cast<int32_t>(i);
 
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -345,7 +349,8 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     if (P.mode == MediatorMode::kNaive) {
       rate = 1.0f;
     } else if (native > 1e-3f) {
-      rate = std::clamp(speed / native * cadence_scale_[slot], P.min_playback_rate, P.max_playback_rate);
+      rate = std::clamp(speed / native * cadence_scale_[slot], P.min_playback_rate,
+                        P.max_playback_rate);
     }
     phase_[slot] = std::fmod(phase_[slot] + freq * rate * dt, 1.0f);
   }
@@ -381,7 +386,8 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   feedback_.thetas[a] = theta_raw;
   if (apm && P.feedback) {
     const DirectionGroup& fg = lib.groups[lib.forward_group];
-    const float max_speed = lib.clips[fg.clips.back()].speed_m_s * P.max_playback_rate * (1.0f + P.max_stride_warp);
+    const float max_speed =
+        lib.clips[fg.clips.back()].speed_m_s * P.max_playback_rate * (1.0f + P.max_stride_warp);
     const float v_len = glm::length(v);
     if (v_len > max_speed) {
       feedback_.velocities[a] = v * (max_speed / v_len);

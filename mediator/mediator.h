@@ -1,7 +1,7 @@
 #pragma once
-// The Animation Planning Mediator: between any CrowdSource and the pose output it decides, per agent
-// and frame, which clips to play at what rate and blend, how the body is oriented, and what the
-// simulator must be told so the two stay consistent (ARCHITECTURE.md, steps 1-6 and 8; step 7,
+// The Animation Planning Mediator: between any CrowdSource and the pose output it decides, per
+// agent and frame, which clips to play at what rate and blend, how the body is oriented, and what
+// the simulator must be told so the two stay consistent (ARCHITECTURE.md, steps 1-6 and 8; step 7,
 // foot locking, runs in the pose synthesis pass where the animated feet are known).
 //
 // All per-agent data lives in slots (structure of arrays) sized for the crowd's capacity at
@@ -52,7 +52,10 @@ struct FeedbackBuffers {
   std::vector<glm::vec2> velocities;
   std::vector<float> thetas;
   AgentFeedback view(size_t n) const {
-    return {{has_feedback.data(), n}, {positions.data(), n}, {velocities.data(), n}, {thetas.data(), n}};
+    return {{has_feedback.data(), n},
+            {positions.data(), n},
+            {velocities.data(), n},
+            {thetas.data(), n}};
   }
 };
 
@@ -78,7 +81,8 @@ class Mediator {
 
  private:
   void init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta);
-  void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta, float dt);
+  void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
+                  float dt);
   void choose_weights(int slot, float speed, float rel_dir, float* out_w) const;
 
   const LocomotionLibrary& library_;

@@ -32,8 +32,8 @@ Summary summarize(std::vector<float>& v) {
   return s;
 }
 
-MetricsRecorder::MetricsRecorder(const LocomotionLibrary& library, float frame_time_s, size_t capacity,
-                                 size_t frames_hint)
+MetricsRecorder::MetricsRecorder(const LocomotionLibrary& library, float frame_time_s,
+                                 size_t capacity, size_t frames_hint)
     : library_(library), dt_(frame_time_s), frames_hint_(frames_hint) {
   const size_t n = capacity * frames_hint;
   torsion_.reserve(n);
@@ -44,7 +44,8 @@ MetricsRecorder::MetricsRecorder(const LocomotionLibrary& library, float frame_t
   rate_.reserve(n);
 }
 
-void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m, const PoseSynthesizer& poses) {
+void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
+                             const PoseSynthesizer& poses) {
   const Skeleton& sk = *library_.skeleton;
   const AnimationPlans& pl = m.plans();
   const MediatorParams& P = m.params();
@@ -133,7 +134,8 @@ MetricsReport MetricsRecorder::finish() const {
   r.heading_error_deg = copy_summary(heading_);
   r.root_error_cm = copy_summary(root_error_);
   r.playback_rate = copy_summary(rate_);
-  r.playback_outside_limits = rate_.empty() ? 0.0 : static_cast<double>(rate_outside_) / rate_.size();
+  r.playback_outside_limits =
+      rate_.empty() ? 0.0 : static_cast<double>(rate_outside_) / rate_.size();
   if (!feedback_change_.empty()) {
     double sum = 0.0;
     for (float x : feedback_change_) sum += x;

@@ -28,7 +28,7 @@ struct MetricsReport {
   // Facing error over the agent-frames whose asked twist (theta against the pelvis) is within the
   // torsion limit: what the upper body could have reached.
   Summary facing_error_within_limit_deg;
-  double playback_outside_limits = 0.0;  // fraction of agent-frames
+  double playback_outside_limits = 0.0;         // fraction of agent-frames
   std::optional<double> feedback_speed_change;  // null when the mediator never changed v
   int64_t pop_count = 0;
   double max_root_jerk = 0.0;  // [m/s^3]

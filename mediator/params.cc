@@ -13,14 +13,15 @@ using K = ParamInfo::Kind;
 using P = MediatorParams;
 
 constexpr ParamInfo kInfos[] = {
-    {"velocity_halflife_s", "s", "smoothing of the simulator's velocity (removes zig-zag)", 0.01f, 1.0f,
-     K::kFloat, &P::velocity_halflife_s},
+    {"velocity_halflife_s", "s", "smoothing of the simulator's velocity (removes zig-zag)", 0.01f,
+     1.0f, K::kFloat, &P::velocity_halflife_s},
     {"theta_halflife_s", "s", "smoothing of the desired torso orientation", 0.01f, 1.0f, K::kFloat,
      &P::theta_halflife_s},
-    {"torsion_limit_deg", "deg", "hard limit on the twist between pelvis and upper chest", 0.0f, 90.0f,
-     K::kFloat, &P::torsion_limit_deg},
-    {"lower_turn_rate_deg_s", "deg/s", "fastest turn of the lower body toward the walking direction",
-     30.0f, 1440.0f, K::kFloat, &P::lower_turn_rate_deg_s},
+    {"torsion_limit_deg", "deg", "hard limit on the twist between pelvis and upper chest", 0.0f,
+     90.0f, K::kFloat, &P::torsion_limit_deg},
+    {"lower_turn_rate_deg_s", "deg/s",
+     "fastest turn of the lower body toward the walking direction", 30.0f, 1440.0f, K::kFloat,
+     &P::lower_turn_rate_deg_s},
     {"blend_time_s", "s", "cross-fade time when the chosen clips change", 0.05f, 1.0f, K::kFloat,
      &P::blend_time_s},
     {"min_playback_rate", "x", "slowest clip playback relative to real time", 0.1f, 1.0f, K::kFloat,
@@ -31,18 +32,18 @@ constexpr ParamInfo kInfos[] = {
      0.5f, K::kFloat, &P::max_stride_warp},
     {"stop_speed_m_s", "m/s", "below this speed the agent stands (idle)", 0.0f, 0.5f, K::kFloat,
      &P::stop_speed_m_s},
-    {"foot_locking", "on/off", "pin planted feet in world space with two-bone IK", 0.0f, 1.0f, K::kBool,
-     nullptr, &P::foot_locking},
+    {"foot_locking", "on/off", "pin planted feet in world space with two-bone IK", 0.0f, 1.0f,
+     K::kBool, nullptr, &P::foot_locking},
     {"lock_release_s", "s", "blend-out time of a released foot lock", 0.02f, 0.5f, K::kFloat,
      &P::lock_release_s},
     {"max_leg_stretch", "x leg", "a lock needing a longer leg than this is released", 0.9f, 1.0f,
      K::kFloat, &P::max_leg_stretch},
-    {"idle_step_distance_m", "m", "standing: foot drift that makes the agent re-plant it", 0.02f, 0.5f,
-     K::kFloat, &P::idle_step_distance_m},
-    {"idle_step_time_s", "s", "duration of a re-planting step while standing or turning", 0.1f, 1.0f,
-     K::kFloat, &P::idle_step_time_s},
-    {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator", 0.0f,
-     1.0f, K::kBool, nullptr, &P::feedback},
+    {"idle_step_distance_m", "m", "standing: foot drift that makes the agent re-plant it", 0.02f,
+     0.5f, K::kFloat, &P::idle_step_distance_m},
+    {"idle_step_time_s", "s", "duration of a re-planting step while standing or turning", 0.1f,
+     1.0f, K::kFloat, &P::idle_step_time_s},
+    {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator",
+     0.0f, 1.0f, K::kBool, nullptr, &P::feedback},
     {"stride_variation", "x", "per-agent spread of stride length (crowd variety)", 0.0f, 0.2f,
      K::kFloat, &P::stride_variation},
 };
@@ -79,9 +80,12 @@ std::string known_names() {
 
 std::string_view mediator_mode_name(MediatorMode mode) {
   switch (mode) {
-    case MediatorMode::kNaive: return "naive";
-    case MediatorMode::kRate: return "rate";
-    case MediatorMode::kApm: return "apm";
+    case MediatorMode::kNaive:
+      return "naive";
+    case MediatorMode::kRate:
+      return "rate";
+    case MediatorMode::kApm:
+      return "apm";
   }
   return "?";
 }
@@ -154,14 +158,16 @@ Status load_mediator_params_json(const std::string& path, MediatorParams* params
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string where = path + ": " + it.key();
     if (it.key() == "mode") {
-      if (!it->is_string()) return Status::Error(where + ": expected \"naive\", \"rate\" or \"apm\"");
+      if (!it->is_string())
+        return Status::Error(where + ": expected \"naive\", \"rate\" or \"apm\"");
       Result<MediatorMode> m = parse_mediator_mode(it->get<std::string>());
       if (!m.ok()) return Status::Error(path + ": " + m.message());
       params->mode = *m;
       continue;
     }
     if (it.key() == "seed") {
-      if (!it->is_number_unsigned()) return Status::Error(where + ": expected a non-negative integer");
+      if (!it->is_number_unsigned())
+        return Status::Error(where + ": expected a non-negative integer");
       params->seed = it->get<uint64_t>();
       continue;
     }
@@ -174,8 +180,8 @@ Status load_mediator_params_json(const std::string& path, MediatorParams* params
       value = it->get<double>();
     } else {
       return Status::Error(where + ": expected a " +
-                           (info->kind == K::kBool ? std::string("boolean") : "number in " +
-                                                                                 std::string(info->unit)));
+                           (info->kind == K::kBool ? std::string("boolean")
+                                                   : "number in " + std::string(info->unit)));
     }
     GK_RETURN_IF_ERROR(set_value(*info, value, where, params));
   }

@@ -24,25 +24,26 @@ struct MediatorParams {
   float velocity_halflife_s = 0.12f;  // [s] [Limit: 0.01..1] smoothing of the simulator's v
   float theta_halflife_s = 0.05f;     // [s] [Limit: 0.01..1] smoothing of the desired torso theta
   // 3. Torso decoupling.
-  float torsion_limit_deg = 60.0f;    // [deg] [Limit: 0..90] max twist pelvis -> upper chest
+  float torsion_limit_deg = 60.0f;       // [deg] [Limit: 0..90] max twist pelvis -> upper chest
   float lower_turn_rate_deg_s = 300.0f;  // [deg/s] [Limit: 30..1440] max lower-body turn rate
   // 4./6. Blending.
-  float blend_time_s = 0.25f;         // [s] [Limit: 0.05..1] cross-fade duration on clip changes
+  float blend_time_s = 0.25f;  // [s] [Limit: 0.05..1] cross-fade duration on clip changes
   // 5. Playback rate and stride warping.
-  float min_playback_rate = 0.7f;     // [ratio] [Limit: 0.1..1] slowest clip-time step / real time
-  float max_playback_rate = 1.35f;    // [ratio] [Limit: 1..3] fastest clip-time step / real time
-  float max_stride_warp = 0.2f;       // [ratio] [Limit: 0..0.5] stride length change taken by IK
-  float stop_speed_m_s = 0.08f;       // [m/s] [Limit: 0..0.5] below this the agent stands
+  float min_playback_rate = 0.7f;   // [ratio] [Limit: 0.1..1] slowest clip-time step / real time
+  float max_playback_rate = 1.35f;  // [ratio] [Limit: 1..3] fastest clip-time step / real time
+  float max_stride_warp = 0.2f;     // [ratio] [Limit: 0..0.5] stride length change taken by IK
+  float stop_speed_m_s = 0.08f;     // [m/s] [Limit: 0..0.5] below this the agent stands
   // 7. Foot locking.
   bool foot_locking = true;
-  float lock_release_s = 0.12f;       // [s] [Limit: 0.02..0.5] blend-out time of a released lock
-  float max_leg_stretch = 0.995f;     // [ratio of leg length] [Limit: 0.9..1] locks beyond release
-  float idle_step_distance_m = 0.12f; // [m] [Limit: 0.02..0.5] planted-foot drift that triggers a step
-  float idle_step_time_s = 0.35f;     // [s] [Limit: 0.1..1] duration of a re-planting step
+  float lock_release_s = 0.12f;    // [s] [Limit: 0.02..0.5] blend-out time of a released lock
+  float max_leg_stretch = 0.995f;  // [ratio of leg length] [Limit: 0.9..1] locks beyond release
+  float idle_step_distance_m =
+      0.12f;                       // [m] [Limit: 0.02..0.5] planted-foot drift that triggers a step
+  float idle_step_time_s = 0.35f;  // [s] [Limit: 0.1..1] duration of a re-planting step
   // 8. Feedback to the simulator.
   bool feedback = true;
   // Variety.
-  float stride_variation = 0.05f;     // [ratio] [Limit: 0..0.2] per-agent clip speed spread
+  float stride_variation = 0.05f;  // [ratio] [Limit: 0..0.2] per-agent clip speed spread
   uint64_t seed = 1;
   MediatorMode mode = MediatorMode::kApm;
 };

@@ -24,9 +24,7 @@ glm::mat4 root_placement(const glm::vec2& xz, float yaw) {
   return m;
 }
 
-glm::quat rotation_of(const glm::mat4& m) {
-  return glm::normalize(glm::quat_cast(glm::mat3(m)));
-}
+glm::quat rotation_of(const glm::mat4& m) { return glm::normalize(glm::quat_cast(glm::mat3(m))); }
 
 // Highest lift [m] of a released foot on its way back to the clip's foot.
 constexpr float kReleaseLiftMax = 0.05f;
@@ -45,8 +43,8 @@ constexpr float kClearSpeed = 0.6f;  // [m/s]
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
 // kMaxDrop, and comes back up at kDropRecovery.
 constexpr float kDropReach = 0.99f;
-constexpr float kMaxDrop = 0.08f;          // [m]
-constexpr float kDropRecovery = 0.25f;     // [m/s]
+constexpr float kMaxDrop = 0.08f;       // [m]
+constexpr float kDropRecovery = 0.25f;  // [m/s]
 
 float smoothstep01(float x) {
   x = std::clamp(x, 0.0f, 1.0f);
@@ -60,14 +58,16 @@ float joint_heading(const glm::mat4& world, const glm::quat& rest_model_rot_inv)
   return std::atan2(f.x, f.z);
 }
 
-PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capacity, bool make_palettes)
+PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capacity,
+                                 bool make_palettes)
     : library_(library),
       skeleton_(*library.skeleton),
       num_joints_(library.skeleton->num_joints()),
       make_palettes_(make_palettes) {
   const size_t J = num_joints_;
   std::vector<glm::mat4> rest(J);
-  LocalToModelJob{&skeleton_, skeleton_.rest_rotations, skeleton_.rest_translations, glm::mat4(1.0f), rest}
+  LocalToModelJob{&skeleton_, skeleton_.rest_rotations, skeleton_.rest_translations,
+                  glm::mat4(1.0f), rest}
       .run();
   rest_model_rot_inv_.resize(J);
   for (size_t j = 0; j < J; ++j) rest_model_rot_inv_[j] = glm::inverse(rotation_of(rest[j]));
@@ -287,7 +287,8 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
         const float u = locks_.timer[k] / P.idle_step_time_s;
         const glm::vec3 from = locks_.from[k];
         target = glm::mix(from, anim_toe, smoothstep01(u));
-        target.y = glm::mix(from.y, anim_toe.y, smoothstep01(u)) + 0.05f * std::sin(3.14159265f * std::min(u, 1.0f));
+        target.y = glm::mix(from.y, anim_toe.y, smoothstep01(u)) +
+                   0.05f * std::sin(3.14159265f * std::min(u, 1.0f));
         weight = 1.0f;
         if (u >= 1.0f) {
           state = FootLockState::kLocked;

@@ -1,17 +1,17 @@
 #pragma once
 // Pose synthesis over the whole crowd (ARCHITECTURE.md step 7 and the pose stage): per agent,
 // sample and blend the planned clips, place the root, twist the spine toward the upper-body facing
-// within the torsion limit, pin planted feet with two-bone IK, and produce world joint transforms and
-// skinning palettes. Parallel over agents; all buffers sized at construction.
+// within the torsion limit, pin planted feet with two-bone IK, and produce world joint transforms
+// and skinning palettes. Parallel over agents; all buffers sized at construction.
 
 #include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
-#include <tbb/enumerable_thread_specific.h>
 
 #include "mediator/locomotion_library.h"
 #include "mediator/mediator.h"
@@ -21,12 +21,12 @@ namespace gk {
 enum class FootLockState : uint8_t { kFree, kLocked, kReleasing, kStepping };
 
 struct FootLocks {
-  std::vector<uint8_t> state;      // FootLockState, [slot * 2 + side]
-  std::vector<glm::vec3> target;   // locked toe position (world) [m]
-  std::vector<glm::vec3> from;     // stepping: where the step started
-  std::vector<float> weight;       // IK weight 0..1
-  std::vector<float> timer;        // stepping progress [s]
-  std::vector<glm::vec3> anim_toe; // the clip's (unlocked) toe position last frame
+  std::vector<uint8_t> state;       // FootLockState, [slot * 2 + side]
+  std::vector<glm::vec3> target;    // locked toe position (world) [m]
+  std::vector<glm::vec3> from;      // stepping: where the step started
+  std::vector<float> weight;        // IK weight 0..1
+  std::vector<float> timer;         // stepping progress [s]
+  std::vector<glm::vec3> anim_toe;  // the clip's (unlocked) toe position last frame
 };
 
 class PoseSynthesizer {
@@ -40,13 +40,16 @@ class PoseSynthesizer {
   int num_joints() const { return num_joints_; }
   // World transforms of one slot's joints, as rendered.
   std::span<const glm::mat4> world(int slot) const {
-    return {world_.data() + static_cast<size_t>(slot) * num_joints_, static_cast<size_t>(num_joints_)};
+    return {world_.data() + static_cast<size_t>(slot) * num_joints_,
+            static_cast<size_t>(num_joints_)};
   }
   std::span<const glm::mat4> palette(int slot) const {
-    return {palette_.data() + static_cast<size_t>(slot) * num_joints_, static_cast<size_t>(num_joints_)};
+    return {palette_.data() + static_cast<size_t>(slot) * num_joints_,
+            static_cast<size_t>(num_joints_)};
   }
   std::span<const glm::quat> local_rotations(int slot) const {
-    return {local_rot_.data() + static_cast<size_t>(slot) * num_joints_, static_cast<size_t>(num_joints_)};
+    return {local_rot_.data() + static_cast<size_t>(slot) * num_joints_,
+            static_cast<size_t>(num_joints_)};
   }
   // Largest change of any joint's local rotation since the slot's previous frame [rad] (0 on an
   // agent's first frame).
@@ -70,7 +73,8 @@ class PoseSynthesizer {
   const Skeleton& skeleton_;
   int num_joints_;
   bool make_palettes_;
-  std::vector<glm::quat> rest_model_rot_inv_;  // inverse rest model rotations: rest-relative forward
+  std::vector<glm::quat>
+      rest_model_rot_inv_;  // inverse rest model rotations: rest-relative forward
   std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::quat> local_rot_;
   std::vector<glm::vec3> local_trans_;

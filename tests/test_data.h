@@ -33,12 +33,12 @@ inline std::string scratch_dir(const std::string& name) {
 }  // namespace gk::test
 
 // Skips the test (or fails it under CI=true) when a shared data file is missing.
-#define GK_REQUIRE_DATA(rel)                                                              \
-  do {                                                                                    \
-    const std::string gk_p_ = ::gk::test::data_path(rel);                                 \
-    if (!std::filesystem::exists(gk_p_)) {                                                \
-      if (::gk::test::under_ci()) FAIL() << "shared data missing under CI: " << gk_p_;    \
-      GTEST_SKIP() << "shared data not found: " << gk_p_                                  \
+#define GK_REQUIRE_DATA(rel)                                                                   \
+  do {                                                                                         \
+    const std::string gk_p_ = ::gk::test::data_path(rel);                                      \
+    if (!std::filesystem::exists(gk_p_)) {                                                     \
+      if (::gk::test::under_ci()) FAIL() << "shared data missing under CI: " << gk_p_;         \
+      GTEST_SKIP() << "shared data not found: " << gk_p_                                       \
                    << " (set GAITKEEPER_DATA to the folder holding clips/ and trajectories/)"; \
-    }                                                                                     \
+    }                                                                                          \
   } while (0)

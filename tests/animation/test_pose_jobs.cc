@@ -5,8 +5,8 @@
 #include <random>
 #include <vector>
 
-#include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
+#include <glm/gtc/quaternion.hpp>
 
 #include "animation/pose_jobs.h"
 
@@ -77,7 +77,8 @@ TEST(SampleClipJob, LoopWrapKeepsRootMotionAndWrapsOtherJoints) {
 
 TEST(BlendPosesJob, WeightedMeanAndHemisphere) {
   const glm::quat a = glm::angleAxis(glm::radians(20.0f), glm::vec3(0, 0, 1));
-  const glm::quat b = -glm::angleAxis(glm::radians(60.0f), glm::vec3(0, 0, 1));  // same rotation, other sign
+  const glm::quat b =
+      -glm::angleAxis(glm::radians(60.0f), glm::vec3(0, 0, 1));  // same rotation, other sign
   glm::vec3 ta(0), tb(4, 0, 0);
   PoseLayer layers[2] = {{{&a, 1}, {&ta, 1}, 3.0f}, {{&b, 1}, {&tb, 1}, 1.0f}};
   glm::quat r;
@@ -97,7 +98,8 @@ TEST(LocalToModelJob, ChainGeometry) {
   std::vector<glm::quat> r(3, glm::quat(1, 0, 0, 0));
   r[1] = glm::angleAxis(glm::radians(90.0f), glm::vec3(1, 0, 0));  // bend the second joint
   std::vector<glm::mat4> m(3);
-  LocalToModelJob job{&s, r, s.rest_translations, glm::translate(glm::mat4(1), glm::vec3(0, 2, 0)), m};
+  LocalToModelJob job{&s, r, s.rest_translations, glm::translate(glm::mat4(1), glm::vec3(0, 2, 0)),
+                      m};
   ASSERT_TRUE(job.validate());
   job.run();
   // j1 at (0, 1.5, 0); its child's offset (0,-0.5,0) rotated 90 deg about x gives (0, 0, -0.5).
@@ -113,7 +115,8 @@ TEST(TwoBoneIKJob, ReachesRandomTargetsWithKneeTowardPole) {
   int reached = 0;
   for (int trial = 0; trial < 200; ++trial) {
     std::vector<glm::quat> r(3);
-    for (auto& q : r) q = glm::normalize(glm::quat(1.0f, 0.3f * u(rng), 0.3f * u(rng), 0.3f * u(rng)));
+    for (auto& q : r)
+      q = glm::normalize(glm::quat(1.0f, 0.3f * u(rng), 0.3f * u(rng), 0.3f * u(rng)));
     std::vector<glm::mat4> m(3);
     LocalToModelJob fk{&s, r, s.rest_translations, glm::mat4(1), m};
     fk.run();

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include <glm/vec3.hpp>
 #include <gtest/gtest.h>
+#include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
 #include "tests/test_data.h"
@@ -45,17 +45,18 @@ nlohmann::json read_json(const std::string& path) {
 TEST(Cli, AnalyzeClipCoversEverySharedClip) {
   GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
   const std::string out = test::scratch_dir("cli") + "/analysis.json";
-  const CommandResult r = run("analyze-clip --json " + test::data_path("clips/bvh") + " " +
-                    test::data_path("clips/gltf/ual_mannequin_quaternius.glb") + " > " + out);
+  const CommandResult r =
+      run("analyze-clip --json " + test::data_path("clips/bvh") + " " +
+          test::data_path("clips/gltf/ual_mannequin_quaternius.glb") + " > " + out);
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json all = read_json(out);
   // 8 BVH clips + 44 glb animations (PROVENANCE.md).
   ASSERT_EQ(all.size(), 52u);
   std::map<std::string, nlohmann::json> by_name;
   for (const auto& c : all) {
-    for (const char* field : {"name", "frames", "fps", "duration_s", "joints", "scale",
-                              "native_speed_m_s", "direction_deg", "cycle", "contacts",
-                              "foot_slide_floor_cm_s"}) {
+    for (const char* field :
+         {"name", "frames", "fps", "duration_s", "joints", "scale", "native_speed_m_s",
+          "direction_deg", "cycle", "contacts", "foot_slide_floor_cm_s"}) {
       EXPECT_TRUE(c.contains(field)) << field;
     }
     by_name[c["name"].get<std::string>()] = c;
@@ -150,8 +151,9 @@ Slide slide_from_csv(const std::string& path, const std::string& toe_l, const st
 TEST(Cli, MetricRecomputedFromTheJointDumpEqualsTheReport) {
   const std::string dir = test::scratch_dir("cli");
   const std::string csv = dir + "/joints.csv", json = dir + "/report.json";
-  const CommandResult r = run("bench --scenario crossing --agents 16 --frames 240 --mode apm --json " + json +
-                    " --dump-joints " + csv);
+  const CommandResult r =
+      run("bench --scenario crossing --agents 16 --frames 240 --mode apm --json " + json +
+          " --dump-joints " + csv);
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json rep = read_json(json);
   const auto& m = rep["metrics"];
@@ -173,8 +175,9 @@ TEST(Cli, MetricRecomputedFromTheJointDumpEqualsTheReport) {
 TEST(Cli, BenchReplaysRealTrajectories) {
   GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
   const std::string json = test::scratch_dir("cli") + "/zara.json";
-  const CommandResult r = run("bench --scenario " + test::data_path("trajectories/zara1/crowds_zara01.txt") +
-                    " --frames 300 --json " + json);
+  const CommandResult r =
+      run("bench --scenario " + test::data_path("trajectories/zara1/crowds_zara01.txt") +
+          " --frames 300 --json " + json);
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json rep = read_json(json);
   EXPECT_GT(rep["crowd"]["max_live_agents"].get<int>(), 0);

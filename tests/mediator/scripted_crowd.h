@@ -64,8 +64,9 @@ class ScriptedCrowd : public CrowdSource {
  private:
   void fill(size_t i) {
     v_[i] = scripts_[i].velocity(t_);
-    th_[i] = scripts_[i].theta ? scripts_[i].theta(t_, v_[i])
-                               : (glm::length(v_[i]) > 1e-4f ? std::atan2(v_[i].x, v_[i].y) : th_[i]);
+    th_[i] = scripts_[i].theta
+                 ? scripts_[i].theta(t_, v_[i])
+                 : (glm::length(v_[i]) > 1e-4f ? std::atan2(v_[i].x, v_[i].y) : th_[i]);
   }
   std::vector<Script> scripts_;
   bool honour_;

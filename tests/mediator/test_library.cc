@@ -37,7 +37,8 @@ TEST(LocomotionLibrary, BuiltinBlendSpace) {
   // Phase tables run forward over exactly one cycle.
   for (const LocomotionClip& c : lib.clips) {
     if (!c.gait) continue;
-    for (int k = 1; k <= kPhaseTableSize; ++k) EXPECT_GE(c.phase_to_time[k], c.phase_to_time[k - 1]);
+    for (int k = 1; k <= kPhaseTableSize; ++k)
+      EXPECT_GE(c.phase_to_time[k], c.phase_to_time[k - 1]);
     EXPECT_NEAR(c.phase_to_time[kPhaseTableSize] - c.phase_to_time[0], c.cycle_s, 1e-4f);
   }
 }

@@ -1,5 +1,5 @@
-// The mediator on scripted crowds with the built-in clips: planted feet, rate limits, torsion limit,
-// facing, feedback and robustness, each measured with the METRICS.md definitions.
+// The mediator on scripted crowds with the built-in clips: planted feet, rate limits, torsion
+// limit, facing, feedback and robustness, each measured with the METRICS.md definitions.
 
 #include <cmath>
 #include <numbers>
@@ -39,7 +39,8 @@ TEST(Mediator, ApmPlantsFeetWhereNaiveSkates) {
 
 TEST(Mediator, PlaybackRateStaysWithinLimitsOverASpeedRamp) {
   // 0 -> 5 m/s over 10 s, beyond the fastest clip: rate limits hold, feedback caps the speed.
-  std::vector<Script> s{{{0, 0}, [](double t) { return glm::vec2(0.0f, 0.5f * float(t)); }, nullptr}};
+  std::vector<Script> s{
+      {{0, 0}, [](double t) { return glm::vec2(0.0f, 0.5f * float(t)); }, nullptr}};
   MediatorParams p;
   const auto r = run_scripted(builtin_library(), s, p, 600);
   EXPECT_EQ(r.report.playback_outside_limits, 0.0);
@@ -54,7 +55,8 @@ TEST(Mediator, TorsionNeverExceedsTheLimit) {
   // theta sweeps all the way round while walking: the twist must clamp at the limit.
   MediatorParams p;
   p.torsion_limit_deg = 40.0f;
-  std::vector<Script> s{{{0, 0}, [](double) { return glm::vec2(0.0f, 1.3f); },
+  std::vector<Script> s{{{0, 0},
+                         [](double) { return glm::vec2(0.0f, 1.3f); },
                          [](double t, glm::vec2) { return float(0.8 * t); }}};
   const auto r = run_scripted(builtin_library(), s, p);
   EXPECT_LE(r.report.torsion_deg.max, 40.5);
@@ -66,7 +68,8 @@ TEST(Mediator, UpperBodyFacesThetaWithinTheLimit) {
   const float look = 35.0f * std::numbers::pi_v<float> / 180.0f;
   std::vector<Script> s;
   for (int i = 0; i < 4; ++i) {
-    s.push_back({{2.0f * i, 0}, [](double) { return glm::vec2(0.0f, 1.2f); },
+    s.push_back({{2.0f * i, 0},
+                 [](double) { return glm::vec2(0.0f, 1.2f); },
                  [look](double, glm::vec2) { return look; }});
   }
   const auto apm = run_scripted(builtin_library(), s, MediatorParams{});
@@ -94,9 +97,15 @@ TEST(Mediator, FeedsBackTheSpeedItCanDeliver) {
 
 TEST(Mediator, SurvivesNaNAndAbsurdInput) {
   std::vector<Script> s{
-      {{0, 0}, [](double t) { return t > 1.0 && t < 2.0 ? glm::vec2(NAN, 1.0f) : glm::vec2(0, 1.2f); }, nullptr},
-      {{3, 0}, [](double t) { return t > 1.0 && t < 1.5 ? glm::vec2(0, 1e6f) : glm::vec2(0, 1.2f); }, nullptr},
-      {{6, 0}, [](double) { return glm::vec2(0, 1.2f); }, [](double, glm::vec2) { return float(NAN); }}};
+      {{0, 0},
+       [](double t) { return t > 1.0 && t < 2.0 ? glm::vec2(NAN, 1.0f) : glm::vec2(0, 1.2f); },
+       nullptr},
+      {{3, 0},
+       [](double t) { return t > 1.0 && t < 1.5 ? glm::vec2(0, 1e6f) : glm::vec2(0, 1.2f); },
+       nullptr},
+      {{6, 0},
+       [](double) { return glm::vec2(0, 1.2f); },
+       [](double, glm::vec2) { return float(NAN); }}};
   const auto r = run_scripted(builtin_library(), s, MediatorParams{}, 240);
   EXPECT_GT(r.sanitised, 0u);
   EXPECT_TRUE(std::isfinite(r.report.root_error_cm.max));
