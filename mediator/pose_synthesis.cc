@@ -38,7 +38,7 @@ constexpr float kHoldToe = 0.045f;
 constexpr float kHoldAnkle = 0.09f;
 // A free foot moving faster than kPlantSpeed low over the ground is lifted to this clearance so it
 // swings instead of dragging; fully from kClearSpeed on.
-constexpr float kClearance = 0.035f;
+constexpr float kClearance = 0.045f;
 constexpr float kClearSpeed = 0.6f;  // [m/s]
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
 // kMaxDrop, and comes back up at kDropRecovery.
