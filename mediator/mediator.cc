@@ -14,7 +14,7 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kAbsurdSpeed = 15.0f;    // [m/s] faster simulator velocities are treated as errors
-constexpr float kRootPullTime = 0.1f;    // [s] how fast the rendered root is pulled onto p
+constexpr float kRootPullTime = 0.25f;   // [s] how fast the rendered root is pulled onto p
 constexpr float kMaxRootOffset = 0.06f;  // [m] the rendered root never strays further from p
 constexpr float kSwitchHysteresis =
     0.26f;  // [rad] a new travel direction group must be this much better

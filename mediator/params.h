@@ -21,7 +21,7 @@ Result<MediatorMode> parse_mediator_mode(std::string_view name);
 
 struct MediatorParams {
   // 1. Input filtering (critically damped springs).
-  float velocity_halflife_s = 0.12f;  // [s] [Limit: 0.01..1] smoothing of the simulator's v
+  float velocity_halflife_s = 0.05f;  // [s] [Limit: 0.01..1] smoothing of the simulator's v
   float theta_halflife_s = 0.05f;     // [s] [Limit: 0.01..1] smoothing of the desired torso theta
   // 3. Torso decoupling.
   float torsion_limit_deg = 60.0f;       // [deg] [Limit: 0..90] max twist pelvis -> upper chest

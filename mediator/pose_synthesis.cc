@@ -39,7 +39,9 @@ constexpr float kHoldAnkle = 0.09f;
 // A free foot moving faster than kPlantSpeed low over the ground is lifted to this clearance so it
 // swings instead of dragging; fully from kClearSpeed on.
 constexpr float kClearance = 0.045f;
-constexpr float kClearSpeed = 0.6f;  // [m/s]
+constexpr float kClearSpeed = 0.6f;    // [m/s]
+constexpr float kMaxLiftSpeed = 1.5f;  // [m/s] fastest change of that lift
+constexpr float kMaxStepSpeed = 1.5f;  // [m/s] a released foot travels back no faster on average
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
 // kMaxDrop, and comes back up at kDropRecovery.
 constexpr float kDropReach = 0.99f;
@@ -94,6 +96,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.weight.assign(capacity * 2, 0.0f);
   locks_.timer.assign(capacity * 2, 0.0f);
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
+  locks_.lift.assign(capacity * 2, 0.0f);
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J] {
     Scratch s;
@@ -186,7 +189,11 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   const float pelvis = joint_heading(world_[base + hips], rest_model_rot_inv_[hips]);
   const float chest_now = joint_heading(world_[base + chest], rest_model_rot_inv_[chest]);
   // The chest should face upper_yaw, but never further than the limit from the pelvis.
-  const float wanted = std::clamp(wrap_pi(upper_yaw - pelvis), -limit, limit);
+  // Unwrapped against last frame's torsion: theta passing behind the back must not flip the twist
+  // from one limit to the other in a single frame.
+  const float previous = has_prev_[slot] ? torsion_[slot] : 0.0f;
+  const float asked = previous + wrap_pi(upper_yaw - pelvis - previous);
+  const float wanted = std::clamp(asked, -limit, limit);
   const float twist = wanted - wrap_pi(chest_now - pelvis);
   const float per_joint = twist / static_cast<float>(chain.size());
   // A world-space rotation R at joint j becomes the local correction inv(Q_j) R Q_j; rotations
@@ -229,6 +236,7 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     if (pl.fresh[slot]) {
       state = FootLockState::kFree;
       weight = 0.0f;
+      locks_.lift[k] = 0.0f;
     }
     switch (state) {
       case FootLockState::kFree:
@@ -268,10 +276,11 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
       case FootLockState::kReleasing: {
         // The foot is carried from where it was pinned to where the clip has it: lifted first,
         // then moved, so a released foot steps instead of sliding over the ground.
-        locks_.timer[k] += dt;
-        const float u = std::min(1.0f, locks_.timer[k] / P.lock_release_s);
+        // timer holds the progress 0..1; a long way back takes longer (at most kMaxStepSpeed).
         const glm::vec3 from = locks_.from[k];
         const float gap = std::hypot(anim_toe.x - from.x, anim_toe.z - from.z);
+        locks_.timer[k] += dt / std::max(P.lock_release_s, gap / kMaxStepSpeed);
+        const float u = std::min(1.0f, locks_.timer[k]);
         const float lift = std::min(kReleaseLiftMax, 5.0f * gap) *
                            std::sqrt(std::max(0.0f, std::sin(3.14159265f * u)));
         target = glm::mix(from, anim_toe, smoothstep01(u)) + glm::vec3(0.0f, lift, 0.0f);
@@ -303,6 +312,10 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
       const float fast = smoothstep01((ground_speed - kPlantSpeed) / (kClearSpeed - kPlantSpeed));
       lift = std::max(0.0f, kClearance - toe_h) * fast;
     }
+    // Rate-limited so the knee never snaps (a pop) when the foot speeds up through the band.
+    const float max_change = kMaxLiftSpeed * dt;
+    lift = std::clamp(lift, locks_.lift[k] - max_change, locks_.lift[k] + max_change);
+    locks_.lift[k] = lift;
     use_ik[side] = weight > 0.0f || lift > 0.0f;
     // Where the toe must go, relative to the animated foot (the ankle moves by the same offset).
     toe_offset[side] = glm::mix(anim_toe, target, weight) + glm::vec3(0.0f, lift, 0.0f) - anim_toe;

@@ -27,6 +27,7 @@ struct FootLocks {
   std::vector<float> weight;        // IK weight 0..1
   std::vector<float> timer;         // stepping progress [s]
   std::vector<glm::vec3> anim_toe;  // the clip's (unlocked) toe position last frame
+  std::vector<float> lift;          // swing clearance lift applied last frame [m]
 };
 
 class PoseSynthesizer {
