@@ -159,7 +159,14 @@ Status DetourCrowdSource::init(const Scenario& scenario, const ScenarioAgents& a
   }
 
   NavMeshBuildParams build;
-  build.cell_size_m = params.cell_size_m;
+  // A scenario scaled up for thousands of agents spans hundreds of metres: coarsen the voxels so
+  // the navmesh grid stays around 2,000 cells a side (walls stay exact; only the walkable margin
+  // is quantised more coarsely).
+  const glm::vec2 extent = scenario.bounds_max - scenario.bounds_min;
+  build.cell_size_m = params.cell_size_m;  // an invalid size is reported by the builder
+  if (params.cell_size_m > 0.0f && std::isfinite(extent.x) && std::isfinite(extent.y)) {
+    build.cell_size_m = std::max(params.cell_size_m, std::max(extent.x, extent.y) / 2000.0f);
+  }
   build.agent_radius_m = max_radius;
   Result<NavMeshPtr> navmesh = build_navmesh(scenario, build);
   if (!navmesh.ok()) return navmesh.status();
