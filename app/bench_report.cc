@@ -143,8 +143,8 @@ std::string summary(const BenchReport& r) {
     s += "  torsion mean/p95/max " + num(m["torsion_deg"]["mean"], 1) + "/" +
          num(m["torsion_deg"]["p95"], 1) + "/" + num(m["torsion_deg"]["max"], 1) +
          " deg; facing error p95 " + num(m["facing_error_deg"]["p95"], 1) + " (within limit " +
-         num(m["facing_error_deg"]["within_limit_p95"], 1) + ")" +
-         " deg; heading error p95 " + num(m["heading_error_deg"]["p95"], 1) + " deg\n";
+         num(m["facing_error_deg"]["within_limit_p95"], 1) + ")" + " deg; heading error p95 " +
+         num(m["heading_error_deg"]["p95"], 1) + " deg\n";
     s += "  root error mean/max " + num(m["root_error_cm"]["mean"], 2) + "/" +
          num(m["root_error_cm"]["max"], 2) + " cm; playback rate " +
          num(m["playback_rate"]["min"], 2) + ".." + num(m["playback_rate"]["max"], 2) +

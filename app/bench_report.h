@@ -78,8 +78,8 @@ struct CrowdReport {
 struct BenchReport {
   std::string gaitkeeper_version;
   std::string scenario;
-  std::string mode = "apm";         // naive | rate | apm
-  std::string sim;                  // CrowdSource::name()
+  std::string mode = "apm";  // naive | rate | apm
+  std::string sim;           // CrowdSource::name()
   int64_t agents = 0;
   int64_t frames = 0;
   double frame_time_s = 1.0 / 60.0;

@@ -1,6 +1,6 @@
 // `gaitkeeper analyze-clip FILE... [--scale S] [--json]`: loads BVH/glTF clips (or the built-in
-// set, FILE = "builtin") and prints each clip's analysis: speed, direction, cycle, foot contacts and
-// the foot-slide floor of METRICS.md.
+// set, FILE = "builtin") and prints each clip's analysis: speed, direction, cycle, foot contacts
+// and the foot-slide floor of METRICS.md.
 
 #include <cmath>
 #include <cstdio>
@@ -47,7 +47,8 @@ nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAna
       {"native_speed_m_s", a.native_speed_m_s},
       {"direction_deg", a.direction_rad * 180.0f / std::numbers::pi_v<float>},
       {"cycle", {{"start_s", a.cycle.start_s}, {"end_s", a.cycle.end_s}}},
-      {"contacts", {{"left", intervals_json(a.contacts[0])}, {"right", intervals_json(a.contacts[1])}}},
+      {"contacts",
+       {{"left", intervals_json(a.contacts[0])}, {"right", intervals_json(a.contacts[1])}}},
       {"foot_slide_floor_cm_s", a.floor.mean_cm_s},
       {"foot_slide_floor_p95_cm_s", a.floor.p95_cm_s},
       {"skate_ratio_floor", a.floor.skate_ratio},
@@ -56,13 +57,16 @@ nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAna
 }
 
 void print_text(const nlohmann::json& j) {
-  std::printf("%s  [%s]\n", j["name"].get<std::string>().c_str(), j["file"].get<std::string>().c_str());
+  std::printf("%s  [%s]\n", j["name"].get<std::string>().c_str(),
+              j["file"].get<std::string>().c_str());
   std::printf("  frames %d @ %.3g fps, %.3f s, %d joints, scale %.6g m/unit (%s)%s\n",
               j["frames"].get<int>(), j["fps"].get<double>(), j["duration_s"].get<double>(),
               j["joints"].get<int>(), j["scale"].get<double>(),
-              j["scale_reason"].get<std::string>().c_str(), j["loops"].get<bool>() ? ", loops" : "");
+              j["scale_reason"].get<std::string>().c_str(),
+              j["loops"].get<bool>() ? ", loops" : "");
   std::printf("  speed %.3f m/s%s, direction %.1f deg, cycle %.3f-%.3f s\n",
-              j["native_speed_m_s"].get<double>(), j["in_place"].get<bool>() ? " (in place: from stance foot)" : "",
+              j["native_speed_m_s"].get<double>(),
+              j["in_place"].get<bool>() ? " (in place: from stance foot)" : "",
               j["direction_deg"].get<double>(), j["cycle"]["start_s"].get<double>(),
               j["cycle"]["end_s"].get<double>());
   for (const char* side : {"left", "right"}) {
@@ -73,8 +77,9 @@ void print_text(const nlohmann::json& j) {
     std::printf("\n");
   }
   std::printf("  foot-slide floor %.2f cm/s (p95 %.2f, skate ratio %.3f, drift %.2f cm/step)\n",
-              j["foot_slide_floor_cm_s"].get<double>(), j["foot_slide_floor_p95_cm_s"].get<double>(),
-              j["skate_ratio_floor"].get<double>(), j["foot_drift_floor_cm_per_step"].get<double>());
+              j["foot_slide_floor_cm_s"].get<double>(),
+              j["foot_slide_floor_p95_cm_s"].get<double>(), j["skate_ratio_floor"].get<double>(),
+              j["foot_drift_floor_cm_per_step"].get<double>());
 }
 
 int run_analyze(const AnalyzeOptions& opt) {

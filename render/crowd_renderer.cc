@@ -187,6 +187,11 @@ int CrowdRenderer::cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport
 
 Status CrowdRenderer::draw(const OrbitCamera& camera, glm::ivec2 viewport_px,
                            std::span<const AgentDraw> agents) {
+  return draw_region(camera, glm::ivec2(0), viewport_px, agents);
+}
+
+Status CrowdRenderer::draw_region(const OrbitCamera& camera, glm::ivec2 origin_px,
+                                  glm::ivec2 viewport_px, std::span<const AgentDraw> agents) {
   if (!initialized_) return Status::Error("draw: renderer not initialised");
   if (viewport_px.x < 1 || viewport_px.y < 1) {
     return Status::Error("draw: bad viewport " + std::to_string(viewport_px.x) + "x" +
@@ -227,9 +232,12 @@ Status CrowdRenderer::draw(const OrbitCamera& camera, glm::ivec2 viewport_px,
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 
   upload_frame_block(camera, viewport_px);
-  glViewport(0, 0, viewport_px.x, viewport_px.y);
-  glDisable(GL_SCISSOR_TEST);  // an UI pass may leave it on
-  glDisable(GL_CULL_FACE);     // enabled per mesh in draw_agents when its winding allows
+  glViewport(origin_px.x, origin_px.y, viewport_px.x, viewport_px.y);
+  // The scissor keeps the clear inside the region (split screen); an UI pass may have left it on
+  // with another rectangle.
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(origin_px.x, origin_px.y, viewport_px.x, viewport_px.y);
+  glDisable(GL_CULL_FACE);  // enabled per mesh in draw_agents when its winding allows
   glCullFace(GL_BACK);
   glFrontFace(GL_CCW);
   glDisable(GL_BLEND);
@@ -248,6 +256,7 @@ Status CrowdRenderer::draw(const OrbitCamera& camera, glm::ivec2 viewport_px,
   stats_.lines_dropped = dropped_lines_;
   lines_.clear();
   dropped_lines_ = 0;
+  glDisable(GL_SCISSOR_TEST);
   glBindVertexArray(0);
   glUseProgram(0);
   if (const GLenum error = glGetError(); error != GL_NO_ERROR) {

@@ -108,6 +108,10 @@ class CrowdRenderer {
 
   // Clears and renders the frame into the bound framebuffer (viewport_px = its size).
   Status draw(const OrbitCamera& camera, glm::ivec2 viewport_px, std::span<const AgentDraw> agents);
+  // Same, into the rectangle at origin_px (GL convention: from the bottom-left corner) of size
+  // viewport_px; only that rectangle is cleared, so two calls make a split screen.
+  Status draw_region(const OrbitCamera& camera, glm::ivec2 origin_px, glm::ivec2 viewport_px,
+                     std::span<const AgentDraw> agents);
 
   RenderSettings& settings() { return settings_; }
   const RenderStats& stats() const { return stats_; }

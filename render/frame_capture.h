@@ -26,6 +26,10 @@ class FrameCapture {
   std::span<const uint8_t> rgba() const {
     return {pixels_.data(), static_cast<size_t>(size_.x) * size_.y * 4};
   }
+  // Writable view of the same pixels, e.g. to stamp labels before saving or streaming.
+  std::span<uint8_t> mutable_rgba() {
+    return {pixels_.data(), static_cast<size_t>(size_.x) * size_.y * 4};
+  }
   // Pixel at (x, y), top-left origin; (0, 0, 0, 0) outside the image.
   glm::u8vec4 pixel(int x, int y) const;
 

@@ -1,0 +1,42 @@
+// `gaitkeeper demo` (and `gaitkeeper` without arguments): the interactive window.
+#include <memory>
+
+#include <CLI/CLI.hpp>
+
+#include "app/commands.h"
+#include "app/demo_app.h"
+
+namespace gk::app {
+
+int run_default_demo() {
+  DemoApp demo(DemoOptions{});
+  return demo.run();
+}
+
+void add_demo_command(CLI::App& app) {
+  auto options = std::make_shared<DemoOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "demo",
+      "The interactive window: the crowd, a panel of parameters, overlays, live metrics "
+      "(also what `gaitkeeper` without arguments opens).");
+  add_crowd_options(cmd, &options->crowd, /*scenario_required=*/false);
+  cmd->add_option("--size", options->size, "Window size WxH (default 1280x720)");
+  cmd->add_flag("--compare", options->compare, "Start in the naive | apm split screen");
+  cmd->add_option("--overlay", options->overlays,
+                  "Overlays on at start: velocity, theta, facing, planted, trails, paths, all");
+  cmd->add_option("--select", options->select, "Agent id to select and follow from the start");
+  cmd->add_option("--click", options->click,
+                  "With --frames: left-click at window pixel X,Y on the last frame (picking)");
+  cmd->add_option("--frames", options->frames, "Run this many frames, then quit (scripted runs)");
+  cmd->add_option("--screenshot", options->screenshot,
+                  "With --frames: save the last frame of the window (panel included) as PNG");
+  cmd->add_option("--report", options->report,
+                  "With --frames: write the panel rectangle and the agents' pixels as JSON");
+  cmd->callback([options] {
+    DemoApp demo(*options);
+    const int code = demo.run();
+    if (code != 0) throw ExitRequest{code};
+  });
+}
+
+}  // namespace gk::app

@@ -1,0 +1,263 @@
+// `gaitkeeper render`: runs a session and renders it offscreen (EGL) into a PNG (the last frame),
+// a folder of numbered PNG frames, or an H.264 video streamed into ffmpeg (no temporary files).
+// --compare splits the screen: the naive crowd on the left, the chosen mode on the right, on the
+// same crowd frames.
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/crowd_session.h"
+#include "app/offscreen.h"
+#include "app/overlays.h"
+#include "render/frame_capture.h"
+#include "render/label_font.h"
+
+namespace gk::app {
+namespace {
+
+constexpr const char* kCmd = "render";
+
+struct RenderOptions {
+  CrowdOptions crowd;
+  std::string frames = "120";
+  std::string out;
+  std::string size = "1280x720";
+  bool compare = false;
+  std::string camera;
+  std::vector<std::string> overlays;
+  std::string follow;
+  std::string report;
+};
+
+enum class OutputKind { kPng, kVideo, kFolder };
+
+// "--camera yaw_deg,pitch_deg,distance_m[,target_x,target_z]" overrides the automatic framing.
+void apply_camera(const std::string& text, OrbitCamera* camera) {
+  std::vector<float> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    v.push_back(parse_number<float>(kCmd, item, "--camera", -1e4f, 1e4f));
+  }
+  if (v.size() != 3 && v.size() != 5) {
+    fail(kCmd, 2,
+         "--camera: expected yaw_deg,pitch_deg,distance_m[,target_x,target_z], got '" + text + "'");
+  }
+  camera->yaw_rad = glm::radians(v[0]);
+  camera->pitch_rad =
+      std::clamp(glm::radians(v[1]), -OrbitCamera::kMaxPitchRad, OrbitCamera::kMaxPitchRad);
+  camera->distance_m = std::max(v[2], 0.5f);
+  if (v.size() == 5) camera->target = glm::vec3(v[3], 0.0f, v[4]);
+}
+
+OverlayToggles parse_overlays(const std::vector<std::string>& names) {
+  OverlayToggles t;
+  for (const std::string& n : names) {
+    if (n == "velocity")
+      t.velocity = true;
+    else if (n == "theta")
+      t.theta = true;
+    else if (n == "facing")
+      t.facing = true;
+    else if (n == "planted")
+      t.planted = true;
+    else if (n == "trails")
+      t.trails = true;
+    else if (n == "paths")
+      t.paths = true;
+    else if (n == "all")
+      t = {true, true, true, true, true, true};
+    else {
+      fail(kCmd, 2,
+           "--overlay: expected velocity, theta, facing, planted, trails, paths or all, got '" + n +
+               "'");
+    }
+  }
+  return t;
+}
+
+// Last frame's agents: ids, ground positions and where their hips (0.9 m up) land in the image,
+// so tests can look at the right pixels.
+void write_report(const std::string& path, const CrowdSession& s, const OrbitCamera& camera,
+                  glm::ivec2 size, bool split) {
+  nlohmann::json agents = nlohmann::json::array();
+  const glm::ivec2 view = split ? glm::ivec2(size.x / 2, size.y) : size;
+  for (const AgentDraw& d : s.lane().draw_span()) {
+    const ProjectedPoint p = camera.project(d.position + glm::vec3(0, 0.9f, 0), view);
+    agents.push_back({{"x", d.position.x},
+                      {"z", d.position.z},
+                      {"px", p.pixel.x},
+                      {"py", p.pixel.y},
+                      {"in_front", p.in_front}});
+  }
+  nlohmann::json j = {{"width", size.x}, {"height", size.y}, {"split", split}, {"agents", agents}};
+  std::ofstream out(path);
+  out << j.dump(1) << "\n";
+  if (!out) fail(kCmd, 1, path + ": cannot write the report");
+}
+
+void run_render(RenderOptions& o) {
+  o.crowd.command = kCmd;
+  if (o.crowd.scenario.empty()) o.crowd.scenario = "crossing";
+  const int frames = parse_number<int>(kCmd, o.frames, "--frames", 1, 1'000'000);
+  OutputKind kind = OutputKind::kFolder;
+  if (ends_with(o.out, ".png"))
+    kind = OutputKind::kPng;
+  else if (ends_with(o.out, ".mp4"))
+    kind = OutputKind::kVideo;
+  const OverlayToggles overlays = parse_overlays(o.overlays);
+  const int64_t follow =
+      o.follow.empty() ? -1 : parse_number<int>(kCmd, o.follow, "--follow", 0, 1 << 30);
+  std::unique_ptr<CrowdSession> session = CrowdSession::create(o.crowd);
+  if (o.compare) session->enable_compare(MediatorMode::kNaive);
+  OffscreenScene scene = open_offscreen_scene(kCmd, *session, o.size);
+  if (o.compare) {
+    // Each half is its own, narrower view of the whole scene.
+    scene.view->camera() = frame_bounds(session->bounds_min(), session->bounds_max(),
+                                        {scene.size.x / 2, scene.size.y});
+  }
+  if (!o.camera.empty()) apply_camera(o.camera, &scene.view->camera());
+  const glm::ivec2 size = scene.size;
+  // Overlays are teaching aids: they stay visible through the bodies.
+  scene.view->renderer().settings().lines_on_top = overlays.any();
+
+  if (kind == OutputKind::kFolder) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.out, ec);
+    if (ec) fail(kCmd, 1, o.out + ": cannot create the folder: " + ec.message());
+  }
+  FILE* video = nullptr;
+  if (kind == OutputKind::kVideo) {
+    if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {
+      fail(kCmd, 1, "ffmpeg not found: install it (apt-get install ffmpeg) or write PNG frames");
+    }
+    // A dying ffmpeg must end in an error message, not in SIGPIPE.
+    std::signal(SIGPIPE, SIG_IGN);
+    const std::string cmd = "ffmpeg -loglevel error -y -f rawvideo -pix_fmt rgb24 -s " +
+                            std::to_string(size.x) + "x" + std::to_string(size.y) +
+                            " -r 60 -i - -c:v libx264 -pix_fmt yuv420p '" + o.out + "'";
+    video = popen(cmd.c_str(), "w");
+    if (!video) fail(kCmd, 1, "cannot start ffmpeg");
+  }
+
+  std::optional<OverlayHistory> history, compare_history;
+  if (overlays.any() || follow >= 0) {
+    history.emplace(*session, session->crowd().capacity());
+    if (o.compare) compare_history.emplace(*session, session->crowd().capacity());
+  }
+  const bool split = o.compare;
+  FrameCapture capture;
+  const int label_scale = std::max(2, size.y / 240);
+  std::string right_label(mediator_mode_name(session->params().mode));
+  for (char& c : right_label) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  for (int f = 0; f < frames; ++f) {
+    if (Status s = session->step(kFrameTime_s); !s.ok()) {
+      if (video) pclose(video);
+      fail(kCmd, 1, "frame " + std::to_string(f) + ": " + s.message());
+    }
+    if (history) history->record(*session, session->lane(), kFrameTime_s);
+    if (compare_history) compare_history->record(*session, session->compare_lane(), kFrameTime_s);
+    const bool needed = kind != OutputKind::kPng || f == frames - 1;
+    if (!needed) continue;
+    session->collect();
+    scene.context->begin_frame();
+    Status drawn;
+    CrowdRenderer& r = scene.view->renderer();
+    if (split) {
+      const int left = size.x / 2;
+      drawn = scene.view->upload(*session, session->compare_lane());
+      if (drawn.ok() && compare_history) {
+        compare_history->draw(*session, session->compare_lane(), overlays, follow, &r);
+      }
+      if (drawn.ok()) drawn = scene.view->draw(session->compare_lane(), {0, 0}, {left, size.y});
+      if (drawn.ok()) drawn = scene.view->upload(*session, session->lane());
+      if (drawn.ok() && history) history->draw(*session, session->lane(), overlays, follow, &r);
+      if (drawn.ok()) drawn = scene.view->draw(session->lane(), {left, 0}, {size.x - left, size.y});
+    } else {
+      drawn = scene.view->upload(*session, session->lane());
+      if (drawn.ok() && history) history->draw(*session, session->lane(), overlays, follow, &r);
+      if (drawn.ok()) drawn = scene.view->draw(session->lane(), {0, 0}, size);
+    }
+    if (!drawn.ok()) fail(kCmd, 1, "frame " + std::to_string(f) + ": " + drawn.message());
+    scene.context->finish_frame();
+    if (Status s = capture.grab(size); !s.ok()) fail(kCmd, 1, s.message());
+    if (split) {
+      stamp_label(capture.mutable_rgba(), size, {8 * label_scale, 8 * label_scale}, "NAIVE",
+                  label_scale);
+      stamp_label(capture.mutable_rgba(), size, {size.x / 2 + 8 * label_scale, 8 * label_scale},
+                  right_label, label_scale);
+      // The divider.
+      for (int y = 0; y < size.y; ++y) {
+        for (int x = size.x / 2 - 1; x <= size.x / 2; ++x) {
+          uint8_t* p = &capture.mutable_rgba()[(static_cast<size_t>(y) * size.x + x) * 4];
+          p[0] = p[1] = p[2] = 20;
+        }
+      }
+    }
+    Status written;
+    if (kind == OutputKind::kVideo) {
+      written = capture.write_rgb(video);
+    } else if (kind == OutputKind::kFolder) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "/frame_%05d.png", f);
+      written = capture.save_png(o.out + name);
+    } else {
+      written = capture.save_png(o.out);
+    }
+    if (!written.ok()) {
+      if (video) pclose(video);
+      fail(kCmd, 1, written.message());
+    }
+    if (kind != OutputKind::kPng || f == frames - 1) {
+      std::fprintf(stderr, "\rrender: frame %d/%d   ", f + 1, frames);
+      std::fflush(stderr);
+    }
+  }
+  std::fprintf(stderr, "\n");
+  if (video) {
+    const int status = pclose(video);
+    if (status != 0)
+      fail(kCmd, 1, "ffmpeg failed writing " + o.out + " (exit " + std::to_string(status) + ")");
+  }
+  if (!o.report.empty()) write_report(o.report, *session, scene.view->camera(), size, split);
+  std::printf("render: %d frames of %s (%d agents, %s%s) written to %s\n", frames,
+              session->setup().scenario_name.c_str(), static_cast<int>(session->frame().size()),
+              std::string(mediator_mode_name(session->params().mode)).c_str(),
+              split ? ", left naive" : "", o.out.c_str());
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app) {
+  auto options = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "render",
+      "Render a crowd offscreen to a PNG (last frame), a folder of PNG frames or an MP4 video.");
+  add_crowd_options(cmd, &options->crowd, /*scenario_required=*/false);
+  cmd->add_option("--frames", options->frames, "Frames to simulate and render (default 120)");
+  cmd->add_option("--out", options->out,
+                  "FILE.png (the last frame), FILE.mp4 (H.264 through ffmpeg) or a folder")
+      ->required();
+  cmd->add_option("--size", options->size, "Image size WxH (default 1280x720)");
+  cmd->add_flag("--compare", options->compare,
+                "Split screen: naive on the left, --mode (default apm) on the right");
+  cmd->add_option("--camera", options->camera,
+                  "yaw_deg,pitch_deg,distance_m[,target_x,target_z] (default: frames the "
+                  "scenario in a 3/4 view)");
+  cmd->add_option("--overlay", options->overlays,
+                  "Teaching overlays: velocity, theta, facing, planted, trails, paths, all");
+  cmd->add_option("--follow", options->follow, "Agent id to mark with a ring");
+  cmd->add_option("--report", options->report,
+                  "Write the last frame's agent positions and image pixels as JSON");
+  cmd->callback([options] { run_render(*options); });
+}
+
+}  // namespace gk::app

@@ -1,0 +1,144 @@
+#include "app/crowd_session.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "animation/procedural.h"
+
+namespace gk::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A replayed file carries no bounds: replay a private copy for up to a minute of its time and take
+// the box of every position seen (cheap: spline evaluation only).
+void replay_bounds(const CrowdOptions& o, glm::vec2* lo, glm::vec2* hi) {
+  CrowdOptions quiet = o;
+  quiet.agents.clear();  // its notice was printed for the real crowd already
+  CrowdSetup probe = make_crowd(quiet, /*threads=*/1, /*seed=*/1);
+  glm::vec2 a(1e30f), b(-1e30f);
+  for (int f = 0; f < 3600; ++f) {
+    if (!probe.crowd->step(static_cast<float>(kFrameTime_s)).ok()) break;
+    for (const glm::vec2& p : probe.crowd->frame().positions)
+      a = glm::min(a, p), b = glm::max(b, p);
+  }
+  if (a.x <= b.x) *lo = a, *hi = b;
+}
+
+}  // namespace
+
+glm::vec3 agent_tint(uint32_t id) {
+  // Golden-ratio hue walk; saturation kept low so the shading still reads.
+  const float hue = std::fmod(static_cast<float>(id) * 0.618034f, 1.0f);
+  const glm::vec3 k = glm::clamp(
+      glm::abs(glm::mod(hue * 6.0f + glm::vec3(0.0f, 4.0f, 2.0f), 6.0f) - 3.0f) - 1.0f, 0.0f, 1.0f);
+  return glm::mix(glm::vec3(1.0f), k, 0.45f) * 0.95f;
+}
+
+std::unique_ptr<CrowdSession> CrowdSession::create(const CrowdOptions& o) {
+  const int threads = parse_number<int>(o.command, o.threads, "--threads", 0, 256);
+  const auto seed =
+      parse_number<uint64_t>(o.command, o.seed, "--seed", 0, std::numeric_limits<uint64_t>::max());
+  std::unique_ptr<CrowdSession> s(new CrowdSession());
+  s->setup_ = make_crowd(o, threads, seed);
+  s->library_ = std::make_unique<LocomotionLibrary>(load_library(o));
+  s->params_ = make_params(o, seed);
+  // The mediator and pose passes run on TBB: cap its workers at --threads (0 = all cores).
+  if (threads > 0) s->thread_cap_.emplace(tbb::global_control::max_allowed_parallelism, threads);
+  s->capacity_ = std::max<size_t>(s->setup_.crowd->capacity(), 1);
+  const Skeleton& skeleton = *s->library_->skeleton;
+  s->num_joints_ = skeleton.num_joints();
+  const auto& lib_mesh = s->library_->mesh;
+  s->mesh_ = lib_mesh && lib_mesh->inverse_bind.size() == static_cast<size_t>(s->num_joints_)
+                 ? lib_mesh
+                 : make_mannequin_mesh(skeleton);
+  s->primary_ = s->make_lane(s->params_);
+  for (const WallSegment& w : s->setup_.walls) s->walls_.emplace_back(w.a.x, w.a.y, w.b.x, w.b.y);
+  if (!s->setup_.walls.empty()) {
+    // The walls show where the action is; a scenario's bounds often include empty margins.
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    for (const WallSegment& w : s->setup_.walls) {
+      lo = glm::min(lo, glm::min(w.a, w.b));
+      hi = glm::max(hi, glm::max(w.a, w.b));
+    }
+    s->bounds_min_ = glm::max(lo, s->setup_.bounds_min);
+    s->bounds_max_ = glm::min(hi, s->setup_.bounds_max);
+  } else if (s->setup_.has_bounds) {
+    s->bounds_min_ = s->setup_.bounds_min;
+    s->bounds_max_ = s->setup_.bounds_max;
+  } else {
+    replay_bounds(o, &s->bounds_min_, &s->bounds_max_);
+  }
+  return s;
+}
+
+CrowdSession::~CrowdSession() = default;
+
+AnimationLane CrowdSession::make_lane(const MediatorParams& params) const {
+  AnimationLane lane;
+  lane.mediator = std::make_unique<Mediator>(*library_, params, capacity_);
+  lane.poses = std::make_unique<PoseSynthesizer>(*library_, capacity_, /*make_palettes=*/true);
+  lane.palettes.assign(capacity_ * static_cast<size_t>(num_joints_), glm::mat4(1.0f));
+  lane.draws.assign(capacity_, AgentDraw{});
+  return lane;
+}
+
+void CrowdSession::enable_compare(MediatorMode mode) {
+  MediatorParams p = params_;
+  p.mode = mode;
+  compare_ = make_lane(p);
+}
+
+void CrowdSession::set_params(const MediatorParams& params) {
+  params_ = params;
+  primary_.mediator->set_params(params);
+  if (compare_) {
+    MediatorParams p = params;
+    p.mode = compare_->mediator->params().mode;
+    compare_->mediator->set_params(p);
+  }
+}
+
+Status CrowdSession::step(double dt_s) {
+  const float dt = static_cast<float>(dt_s);
+  CrowdSource& crowd = *setup_.crowd;
+  auto t = Clock::now();
+  GK_RETURN_IF_ERROR(crowd.step(dt));
+  frame_ = crowd.frame();
+  times_.sim_ms = ms_since(t);
+  t = Clock::now();
+  GK_RETURN_IF_ERROR(primary_.mediator->plan(frame_, dt));
+  GK_RETURN_IF_ERROR(crowd.apply_feedback(primary_.mediator->feedback().view(frame_.size())));
+  if (compare_) GK_RETURN_IF_ERROR(compare_->mediator->plan(frame_, dt));
+  times_.mediator_ms = ms_since(t);
+  t = Clock::now();
+  primary_.poses->run(*primary_.mediator, dt);
+  if (compare_) compare_->poses->run(*compare_->mediator, dt);
+  times_.pose_ms = ms_since(t);
+  ++frames_run_;
+  return Status::Ok();
+}
+
+void CrowdSession::collect_lane(AnimationLane* lane) const {
+  const AnimationPlans& plans = lane->mediator->plans();
+  const size_t n = std::min(frame_.size(), capacity_);
+  const size_t J = static_cast<size_t>(num_joints_);
+  for (size_t i = 0; i < n; ++i) {
+    const int slot = plans.slot_of_agent[i];
+    const auto palette = lane->poses->palette(slot);
+    std::copy(palette.begin(), palette.end(), lane->palettes.begin() + i * J);
+    const glm::vec2 root = plans.root_xz[slot];
+    lane->draws[i] = AgentDraw{glm::vec3(root.x, 0.0f, root.y), agent_tint(frame_.ids[i]), 0};
+  }
+  lane->num_collected = n;
+}
+
+void CrowdSession::collect() {
+  collect_lane(&primary_);
+  if (compare_) collect_lane(&compare_.value());
+}
+
+}  // namespace gk::app

@@ -1,0 +1,112 @@
+#pragma once
+// One running crowd with its animation: the frame loop of ARCHITECTURE.md shared by `bench`,
+// `render` and the demo. step(dt) runs sim -> Mediator::plan -> apply_feedback -> pose synthesis;
+// collect() then lays out what the renderer needs: the live agents' skinning palettes
+// (contiguous, in frame order) and their AgentDraw records.
+//
+// A second "compare" lane (another Mediator + PoseSynthesizer, e.g. naive) can be fed the very same
+// crowd frames; only the primary lane's feedback reaches the simulator, so both lanes show one
+// crowd. Everything per frame is sized at creation: step() and collect() allocate nothing.
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <tbb/global_control.h>
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+
+#include "animation/mesh.h"
+#include "app/crowd_setup.h"
+#include "mediator/mediator.h"
+#include "mediator/pose_synthesis.h"
+#include "render/crowd_renderer.h"
+
+namespace gk::app {
+
+// Milliseconds of the last step's stages.
+struct SessionTimes {
+  double sim_ms = 0.0;
+  double mediator_ms = 0.0;  // plan + apply_feedback (+ the compare lane's plan)
+  double pose_ms = 0.0;
+};
+
+// One animation pipeline over the crowd: planning, poses, and the draw data built from them.
+struct AnimationLane {
+  std::unique_ptr<Mediator> mediator;
+  std::unique_ptr<PoseSynthesizer> poses;
+  std::vector<glm::mat4> palettes;  // capacity * joints, filled by collect() for live agents
+  std::vector<AgentDraw> draws;     // capacity
+  size_t num_collected = 0;
+  std::span<const glm::mat4> palette_span(int joints) const {
+    return {palettes.data(), num_collected * static_cast<size_t>(joints)};
+  }
+  std::span<const AgentDraw> draw_span() const { return {draws.data(), num_collected}; }
+};
+
+class CrowdSession {
+ public:
+  // Builds the crowd source, the clip library, the mediator, the pose synthesizer (palettes on)
+  // from the options. Bad options end the command through fail() (ExitRequest).
+  static std::unique_ptr<CrowdSession> create(const CrowdOptions& options);
+  ~CrowdSession();
+
+  // Adds (or replaces) the compare lane with its own mode; the other parameters are the primary's.
+  void enable_compare(MediatorMode mode);
+  void disable_compare() { compare_.reset(); }
+  bool has_compare() const { return compare_.has_value(); }
+
+  Status step(double dt_s);
+  // Fills palettes and draws of the primary lane (and the compare lane, when present).
+  void collect();
+
+  const AgentFrame& frame() const { return frame_; }
+  const AnimationLane& lane() const { return primary_; }
+  const AnimationLane& compare_lane() const { return *compare_; }
+  const Mediator& mediator() const { return *primary_.mediator; }
+  const PoseSynthesizer& poses() const { return *primary_.poses; }
+  CrowdSource& crowd() { return *setup_.crowd; }
+  const CrowdSetup& setup() const { return setup_; }
+  const LocomotionLibrary& library() const { return *library_; }
+  const SkinnedMesh& mesh() const { return *mesh_; }
+  int joints() const { return num_joints_; }
+  const MediatorParams& params() const { return params_; }
+  // New parameters for both lanes (the compare lane keeps its mode).
+  void set_params(const MediatorParams& params);
+  const SessionTimes& times() const { return times_; }
+  int64_t frames_run() const { return frames_run_; }
+  // Walls as (x0, z0, x1, z1) [m] for CrowdRenderer::set_walls.
+  const std::vector<glm::vec4>& wall_segments() const { return walls_; }
+  // Region worth looking at [m]: the walls' box, else the scenario's bounds, else (replay) the box
+  // of the tracks' first minute.
+  glm::vec2 bounds_min() const { return bounds_min_; }
+  glm::vec2 bounds_max() const { return bounds_max_; }
+
+ private:
+  CrowdSession() = default;
+  AnimationLane make_lane(const MediatorParams& params) const;
+  void collect_lane(AnimationLane* lane) const;
+
+  CrowdSetup setup_;
+  std::unique_ptr<LocomotionLibrary> library_;  // stable address: the mediators refer to it
+  std::shared_ptr<const SkinnedMesh> mesh_;
+  std::optional<tbb::global_control> thread_cap_;
+  MediatorParams params_;
+  size_t capacity_ = 1;
+  int num_joints_ = 0;
+  AnimationLane primary_;
+  std::optional<AnimationLane> compare_;
+  AgentFrame frame_;
+  SessionTimes times_;
+  int64_t frames_run_ = 0;
+  std::vector<glm::vec4> walls_;
+  glm::vec2 bounds_min_{-10.0f}, bounds_max_{10.0f};
+};
+
+// A distinct, muted colour per agent id (linear RGB), so agents can be told apart and followed.
+glm::vec3 agent_tint(uint32_t id);
+
+}  // namespace gk::app

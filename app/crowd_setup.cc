@@ -1,0 +1,172 @@
+#include "app/crowd_setup.h"
+
+#include <charconv>
+#include <cstdio>
+#include <limits>
+
+#include <CLI/CLI.hpp>
+
+#include "animation/clip_library.h"
+#include "animation/procedural.h"
+#include "app/commands.h"
+#include "crowd/detour_crowd.h"
+#include "crowd/social_forces.h"
+#include "crowd/trajectory_replay.h"
+
+namespace gk::app {
+
+namespace {
+std::string& last_failure_text() {
+  static std::string text;
+  return text;
+}
+}  // namespace
+
+const std::string& last_failure() { return last_failure_text(); }
+
+void fail(const std::string& command, int code, const std::string& message) {
+  last_failure_text() = message;
+  std::fprintf(stderr, "gaitkeeper %s: %s\n", command.c_str(), message.c_str());
+  throw ExitRequest{code};
+}
+
+template <typename T>
+T parse_number(const std::string& command, const std::string& text, const char* option, T lo,
+               T hi) {
+  T value{};
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || ptr != end || !(value >= lo && value <= hi)) {
+    fail(command, 2,
+         std::string(option) + ": expected a number in [" + std::to_string(lo) + ", " +
+             std::to_string(hi) + "], got '" + text + "'");
+  }
+  return value;
+}
+template int parse_number<int>(const std::string&, const std::string&, const char*, int, int);
+template float parse_number<float>(const std::string&, const std::string&, const char*, float,
+                                   float);
+template uint64_t parse_number<uint64_t>(const std::string&, const std::string&, const char*,
+                                         uint64_t, uint64_t);
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
+  CLI::Option* scenario = cmd->add_option(
+      "--scenario", o->scenario,
+      "Scenario name (data/scenarios, or $GAITKEEPER_SCENARIOS), a scenario .json file, "
+      "or an ETH/UCY trajectory .txt file to replay");
+  if (scenario_required) scenario->required();
+  cmd->add_option("--sim", o->sim, "Crowd simulator: social (default) or detour");
+  cmd->add_option("--agents", o->agents,
+                  "Number of agents (default: the scenario's default_agents); the scenario's "
+                  "geometry grows to keep its spawn density");
+  cmd->add_option("--seed", o->seed, "Seed of the agents' spawn positions, speeds, goals");
+  cmd->add_option("--threads", o->threads,
+                  "Threads of the simulator (1 = single-threaded, default; 0 = all cores)");
+  cmd->add_option("--trajectory-frame-time", o->trajectory_frame_time,
+                  "Seconds between two samples of a replayed trajectory (default 0.4)");
+  cmd->add_option("--mode", o->mode,
+                  "naive (nearest clip at native rate), rate (speed-matched playback only) or "
+                  "apm (the whole mediator; default)");
+  cmd->add_option("--clips", o->clips,
+                  "BVH/glTF/GLB files or folders forming the clip library (default: built-in)");
+  cmd->add_option("--set", o->sets,
+                  "Mediator parameter, e.g. --set torsion_limit_deg=40 (repeatable)");
+  cmd->add_option("--params", o->params_file, "JSON file of mediator parameters");
+}
+
+CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
+  const std::string& cmd = o.command;
+  if (o.sim != "social" && o.sim != "detour") {
+    fail(cmd, 2, "--sim: expected 'social' or 'detour', got '" + o.sim + "'");
+  }
+  CrowdSetup src;
+  if (ends_with(o.scenario, ".txt")) {
+    if (o.sim != "social") {
+      fail(cmd, 2, "--sim " + o.sim + " needs a scenario, not a trajectory file");
+    }
+    if (!o.agents.empty()) {
+      std::fprintf(stderr, "gaitkeeper %s: --agents ignored for replay\n", cmd.c_str());
+    }
+    ReplayOptions replay;
+    replay.frame_time_s =
+        parse_number<float>(cmd, o.trajectory_frame_time, "--trajectory-frame-time", 1e-3f, 60.0f);
+    auto loaded = load_trajectory_replay(o.scenario, replay);
+    if (!loaded.ok()) fail(cmd, 2, loaded.message());
+    src.crowd = std::move(loaded).value();
+    src.scenario_name = o.scenario;
+    src.agents = static_cast<int64_t>(src.crowd->capacity());
+    return src;
+  }
+  auto loaded = load_scenario_by_name(o.scenario, scenario_dir());
+  if (!loaded.ok()) fail(cmd, 2, loaded.message());
+  const int num_agents = o.agents.empty()
+                             ? loaded->default_agents
+                             : parse_number<int>(cmd, o.agents, "--agents", 0, kMaxScenarioAgents);
+  const Scenario scenario = scale_scenario(*loaded, num_agents);
+  auto agents = expand_agents(scenario, num_agents, seed);
+  if (!agents.ok()) fail(cmd, 2, agents.message());
+  src.scenario_name = loaded->name;
+  src.agents = num_agents;
+  src.walls = scenario.walls;
+  src.bounds_min = scenario.bounds_min;
+  src.bounds_max = scenario.bounds_max;
+  src.has_bounds = true;
+  if (o.sim == "social") {
+    SocialForceParams params;
+    params.threads = threads;
+    auto sim = SocialForces::create(scenario, *agents, params);
+    if (!sim.ok()) fail(cmd, 2, sim.message());
+    src.social = sim->get();
+    src.crowd = std::move(sim).value();
+  } else {
+    DetourParams params;
+    params.seed = seed;
+    auto sim = make_detour_crowd(scenario, *agents, params);
+    if (!sim.ok()) fail(cmd, 2, sim.message());
+    src.crowd = std::move(sim).value();
+  }
+  return src;
+}
+
+LocomotionLibrary load_library(const CrowdOptions& o) {
+  std::vector<ClipSet> sets;
+  if (o.clips.empty()) {
+    sets.push_back(make_builtin_clip_set());
+  } else {
+    auto files = expand_clip_paths(o.clips);
+    if (!files.ok()) fail(o.command, 2, files.message());
+    if (files->empty()) fail(o.command, 2, "--clips: no .bvh, .gltf or .glb file found");
+    for (const std::string& f : *files) {
+      auto set = load_clip_file(f);
+      if (!set.ok()) fail(o.command, 2, set.message());
+      sets.push_back(std::move(*set));
+    }
+  }
+  auto lib = build_locomotion_library(sets);
+  if (!lib.ok()) fail(o.command, 2, lib.message());
+  return std::move(*lib);
+}
+
+MediatorParams make_params(const CrowdOptions& o, uint64_t seed) {
+  MediatorParams p;
+  p.seed = seed;
+  if (!o.params_file.empty()) {
+    if (Status s = load_mediator_params_json(o.params_file, &p); !s.ok()) {
+      fail(o.command, 2, s.message());
+    }
+  }
+  auto mode = parse_mediator_mode(o.mode);
+  if (!mode.ok()) fail(o.command, 2, "--mode: expected naive, rate or apm, got '" + o.mode + "'");
+  p.mode = *mode;
+  for (const std::string& a : o.sets) {
+    if (Status s = set_mediator_param(a, &p); !s.ok()) fail(o.command, 2, s.message());
+  }
+  return p;
+}
+
+}  // namespace gk::app

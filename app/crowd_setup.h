@@ -1,0 +1,73 @@
+#pragma once
+// The crowd options shared by `bench`, `render` and the demo (scenario, simulator, agents, seed,
+// threads, mode, clips, mediator parameters) and the pieces built from them: the CrowdSource, the
+// clip library and the mediator parameters. Bad options end the program through ExitRequest with
+// "gaitkeeper <command>: <what was expected>" on stderr and exit code 2.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "crowd/crowd_source.h"
+#include "crowd/scenario.h"
+#include "mediator/locomotion_library.h"
+#include "mediator/params.h"
+
+namespace CLI {
+class App;
+}
+
+namespace gk {
+class SocialForces;
+}
+
+namespace gk::app {
+
+inline constexpr double kFrameTime_s = 1.0 / 60.0;
+
+struct CrowdOptions {
+  std::string command = "bench";  // names the command in error messages
+  std::string scenario;
+  std::string sim = "social";
+  std::string agents, seed = "1", threads = "1", trajectory_frame_time = "0.4";
+  std::string mode = "apm";
+  std::vector<std::string> clips;
+  std::vector<std::string> sets;
+  std::string params_file;
+};
+
+// Registers the options above on a subcommand. `scenario_required`: bench needs one; render and
+// the demo default to `o->scenario` as set by the caller.
+void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required);
+
+// Prints "gaitkeeper <command>: message" and ends the command with `code`.
+[[noreturn]] void fail(const std::string& command, int code, const std::string& message);
+// The message of the last fail() (the demo shows it in its panel instead of exiting).
+const std::string& last_failure();
+
+// Numbers are parsed here rather than by CLI11 so that every bad value gets exit code 2 and a
+// message that names the option and its range.
+template <typename T>
+T parse_number(const std::string& command, const std::string& text, const char* option, T lo, T hi);
+
+struct CrowdSetup {
+  std::unique_ptr<CrowdSource> crowd;
+  SocialForces* social = nullptr;  // set when the source is the social-forces simulator
+  std::string scenario_name;
+  int64_t agents = 0;
+  // Geometry for the renderer and the camera; a replayed file has no walls and its bounds are
+  // those of its tracks (estimated from the first frames by the session).
+  std::vector<WallSegment> walls;
+  glm::vec2 bounds_min{-10.0f}, bounds_max{10.0f};
+  bool has_bounds = false;
+};
+
+CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed);
+// The clip library: the built-in set, or the given files and folders (one clip set per file).
+LocomotionLibrary load_library(const CrowdOptions& o);
+MediatorParams make_params(const CrowdOptions& o, uint64_t seed);
+
+bool ends_with(const std::string& s, const std::string& suffix);
+
+}  // namespace gk::app

@@ -1,0 +1,239 @@
+// The demo's Dear ImGui panel: crowd (rebuilds the session), mediator parameters (live), view and
+// overlays, live metrics with plots, per-stage timings, and the selected agent's animation state.
+#include <cstdio>
+#include <string>
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include "app/demo_app.h"
+
+namespace gk::app {
+namespace {
+
+constexpr float kPanelWidth = static_cast<float>(kPanelWidth_px);
+constexpr const char* kSims[] = {"social forces", "DetourCrowd", "replay a trajectory file"};
+constexpr const char* kModes[] = {"naive", "rate", "apm"};
+
+void help_marker(const char* text) {
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
+}
+
+}  // namespace
+
+void DemoApp::draw_panel() {
+  const ImGuiIO& io = ImGui::GetIO();
+  ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - kPanelWidth, 0.0f), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(kPanelWidth, io.DisplaySize.y), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(1.0f);
+  ImGui::Begin("Gaitkeeper", nullptr,
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  panel_rect_ = glm::vec4(pos.x, pos.y, size.x, size.y);
+  if (!status_.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.3f, 1.0f), "%s", status_.c_str());
+  if (ImGui::CollapsingHeader("Crowd", ImGuiTreeNodeFlags_DefaultOpen)) panel_crowd();
+  if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) panel_view();
+  if (ImGui::CollapsingHeader("Metrics", ImGuiTreeNodeFlags_DefaultOpen)) panel_metrics();
+  if (ImGui::CollapsingHeader("Selected agent", ImGuiTreeNodeFlags_DefaultOpen)) panel_agent();
+  if (ImGui::CollapsingHeader("Mediator parameters")) panel_params();
+  ImGui::End();
+}
+
+void DemoApp::panel_crowd() {
+  bool changed = false;
+  if (ImGui::Combo("simulator", &sim_kind_, kSims, 3)) changed = sim_kind_ != 2;
+  if (sim_kind_ == 2) {
+    ImGui::InputText("file", &replay_path_);
+    help_marker(
+        "An ETH/UCY trajectory .txt file (frame id x y), e.g. "
+        "../shared/data/trajectories/zara1/crowds_zara01.txt");
+    if (ImGui::Button("load trajectory")) changed = true;
+  } else if (ImGui::BeginCombo("scenario", crowd_.scenario.c_str())) {
+    for (const std::string& name : scenario_names_) {
+      if (ImGui::Selectable(name.c_str(), name == crowd_.scenario)) {
+        crowd_.scenario = name;
+        changed = true;
+      }
+    }
+    ImGui::EndCombo();
+  }
+  if (sim_kind_ != 2) {
+    ImGui::InputInt("agents", &agents_, 10, 100);
+    help_marker(
+        "Agent count; the scenario's geometry grows to keep its spawn density. Applied "
+        "when you leave the field.");
+    if (ImGui::IsItemDeactivatedAfterEdit()) changed = true;
+  }
+  if (ImGui::Checkbox("built-in clips", &builtin_clips_) && builtin_clips_) changed = true;
+  if (!builtin_clips_) {
+    ImGui::InputText("clips", &clip_path_);
+    help_marker("A BVH/glTF/GLB file or a folder of them, e.g. ../shared/data/clips/bvh");
+    if (ImGui::Button("load clips")) changed = true;
+  }
+  int mode = static_cast<int>(session_->params().mode);
+  if (ImGui::Combo("mode", &mode, kModes, 3)) {
+    MediatorParams p = session_->params();
+    p.mode = static_cast<MediatorMode>(mode);
+    session_->set_params(p);
+  }
+  help_marker(
+      "naive: nearest clip at its native rate (skating); rate: speed-matched playback "
+      "only; apm: the whole mediator");
+  if (changed) {
+    crowd_.sim = sim_kind_ == 1 ? "detour" : "social";
+    if (sim_kind_ == 2) {
+      crowd_.scenario = replay_path_;
+      crowd_.agents.clear();
+    } else {
+      if (ends_with(crowd_.scenario, ".txt")) crowd_.scenario = "crossing";
+      crowd_.agents = std::to_string(std::max(agents_, 0));
+    }
+    crowd_.clips.clear();
+    if (!builtin_clips_) crowd_.clips.push_back(clip_path_);
+    // Keep the current parameters (and mode) across the rebuild.
+    crowd_.sets.clear();
+    crowd_.params_file.clear();
+    crowd_.mode = std::string(mediator_mode_name(session_->params().mode));
+    const MediatorParams keep = session_->params();
+    if (rebuild()) session_->set_params(keep);
+  }
+  ImGui::Text("%s, %zu live agents, t = %.1f s", session_->crowd().name().c_str(),
+              session_->frame().size(), session_->crowd().time_s());
+}
+
+void DemoApp::panel_view() {
+  ImGui::Checkbox("pause", &paused_);
+  ImGui::SameLine();
+  if (ImGui::Button("step")) step_once_ = true, paused_ = true;
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(140.0f);
+  ImGui::SliderFloat("time scale", &time_scale_, 0.05f, 2.0f, "%.2fx");
+  if (ImGui::Checkbox("compare naive | apm", &compare_)) {
+    if (compare_) {
+      session_->enable_compare(MediatorMode::kNaive);
+      compare_history_.emplace(*session_, session_->crowd().capacity());
+      compare_metrics_.reset();
+    } else {
+      session_->disable_compare();
+    }
+  }
+  help_marker(
+      "Split screen on the same crowd: the naive crowd on the left, the chosen mode on "
+      "the right (only the right one feeds back to the simulator).");
+  ImGui::Checkbox("v", &overlays_.velocity);
+  help_marker("Simulator velocity v (green arrow on the ground, 0.5 s of travel)");
+  ImGui::SameLine();
+  ImGui::Checkbox("theta", &overlays_.theta);
+  help_marker("Desired torso orientation theta from the simulator (yellow, above the head)");
+  ImGui::SameLine();
+  ImGui::Checkbox("facing", &overlays_.facing);
+  help_marker("Lower body (pelvis, blue) and upper body (chest, orange) facing");
+  ImGui::Checkbox("planted feet", &overlays_.planted);
+  help_marker("White crosses: feet locked in world space by two-bone IK");
+  ImGui::SameLine();
+  ImGui::Checkbox("foot trails", &overlays_.trails);
+  help_marker("Toe positions while on the ground: green = still, red = sliding >= 30 cm/s");
+  ImGui::SameLine();
+  ImGui::Checkbox("paths", &overlays_.paths);
+  help_marker("Root path of the last 4 s");
+  ImGui::TextDisabled("right drag orbit, middle drag pan, wheel zoom, click an agent");
+}
+
+void DemoApp::panel_metrics() {
+  const int n = metrics_.count();
+  for (int s = 0; s < kNumLiveSeries; ++s) {
+    const auto series = static_cast<LiveSeries>(s);
+    char overlay[64];
+    if (session_->has_compare() && compare_metrics_.count() > 0) {
+      std::snprintf(overlay, sizeof(overlay), "%.2f %s (naive %.2f)", metrics_.mean(series),
+                    LiveMetrics::unit(series), compare_metrics_.mean(series));
+    } else {
+      std::snprintf(overlay, sizeof(overlay), "%.2f %s (5 s mean)", metrics_.mean(series),
+                    LiveMetrics::unit(series));
+    }
+    ImGui::PlotLines(LiveMetrics::label(series), metrics_.series(series), n, 0, overlay, FLT_MAX,
+                     FLT_MAX, ImVec2(0, 36));
+  }
+  ImGui::Text("ms:");
+  for (int s = 0; s < kNumLiveStages; ++s) {
+    ImGui::SameLine();
+    ImGui::Text("%s %.2f", LiveMetrics::stage_name(static_cast<LiveStage>(s)),
+                metrics_.stage_ms(static_cast<LiveStage>(s)));
+    if (s == 2) ImGui::NewLine();
+  }
+  ImGui::PlotLines("frame ms", metrics_.stage_series(), metrics_.stage_count(), 0, nullptr, 0.0f,
+                   FLT_MAX, ImVec2(0, 36));
+}
+
+void DemoApp::panel_agent() {
+  if (selected_id_ < 0) {
+    ImGui::TextDisabled("click an agent to follow it");
+    return;
+  }
+  const AgentFrame& frame = session_->frame();
+  int index = -1;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    if (frame.ids[i] == selected_id_) index = static_cast<int>(i);
+  }
+  if (index < 0) {
+    ImGui::Text("agent %lld has left", static_cast<long long>(selected_id_));
+    return;
+  }
+  const AnimationPlans& plans = session_->mediator().plans();
+  const int slot = plans.slot_of_agent[index];
+  ImGui::Text("agent %lld  speed %.2f m/s  %s", static_cast<long long>(selected_id_),
+              plans.speed_m_s[slot], plans.standing[slot] ? "(standing)" : "");
+  ImGui::Checkbox("follow", &follow_);
+  ImGui::Text("phase %.2f  playback rate %.2fx  blend %.2f", plans.phase[slot],
+              plans.playback_rate[slot], plans.blend_progress[slot]);
+  ImGui::Text("torsion %.1f deg", session_->poses().torsion(slot) * 57.29578f);
+  const auto& clips = session_->library().clips;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const int c = plans.layer_clip[slot * kMaxBlendLayers + k];
+    const float w = plans.layer_weight[slot * kMaxBlendLayers + k];
+    if (c < 0 || c >= static_cast<int>(clips.size()) || w <= 0.0f) continue;
+    ImGui::ProgressBar(w, ImVec2(120.0f, 0.0f));
+    ImGui::SameLine();
+    ImGui::Text("%s", clips[c].clip.name.c_str());
+  }
+  const FootLocks& locks = session_->poses().foot_locks();
+  static constexpr const char* kLock[] = {"free", "locked", "releasing", "stepping"};
+  ImGui::Text("left foot %s, right foot %s", kLock[std::min<int>(locks.state[slot * 2], 3)],
+              kLock[std::min<int>(locks.state[slot * 2 + 1], 3)]);
+}
+
+void DemoApp::panel_params() {
+  MediatorParams p = session_->params();
+  bool changed = false;
+  for (const ParamInfo& info : mediator_param_infos()) {
+    ImGui::PushID(info.name);
+    if (info.kind == ParamInfo::Kind::kBool) {
+      changed |= ImGui::Checkbox(info.name, &(p.*info.b));
+    } else {
+      char format[48];
+      std::snprintf(format, sizeof(format), "%%.3f %s", info.unit);
+      changed |= ImGui::SliderFloat(info.name, &(p.*info.f), info.min_value, info.max_value, format,
+                                    ImGuiSliderFlags_AlwaysClamp);
+    }
+    if (ImGui::IsItemHovered()) {
+      if (info.kind == ParamInfo::Kind::kBool) {
+        ImGui::SetTooltip("%s", info.help);
+      } else {
+        ImGui::SetTooltip("%s\n[%s], limits %g..%g", info.help, info.unit, info.min_value,
+                          info.max_value);
+      }
+    }
+    ImGui::PopID();
+  }
+  if (ImGui::Button("defaults")) {
+    const MediatorMode mode = p.mode;
+    const uint64_t seed = p.seed;
+    p = MediatorParams{};
+    p.mode = mode;
+    p.seed = seed;
+    changed = true;
+  }
+  if (changed && validate_mediator_params(p).ok()) session_->set_params(p);
+}
+
+}  // namespace gk::app

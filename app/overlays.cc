@@ -1,0 +1,163 @@
+#include "app/overlays.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+namespace gk::app {
+namespace {
+
+glm::vec3 heading_dir(float yaw) { return {std::sin(yaw), 0.0f, std::cos(yaw)}; }
+
+void arrow(CrowdRenderer* r, glm::vec3 from, glm::vec3 dir, float length, glm::vec3 color) {
+  if (length < 1e-3f) return;
+  const glm::vec3 tip = from + dir * length;
+  const glm::vec3 side = glm::normalize(glm::cross(dir, glm::vec3(0, 1, 0))) * 0.06f;
+  r->add_line(from, tip, color);
+  r->add_line(tip, tip - dir * 0.12f + side, color);
+  r->add_line(tip, tip - dir * 0.12f - side, color);
+}
+
+void cross(CrowdRenderer* r, glm::vec3 p, float half, glm::vec3 color) {
+  r->add_line(p - glm::vec3(half, 0, half), p + glm::vec3(half, 0, half), color);
+  r->add_line(p - glm::vec3(half, 0, -half), p + glm::vec3(half, 0, -half), color);
+}
+
+glm::vec3 slide_color(float slide_m_s) {
+  const float t = std::clamp(slide_m_s / kSkateSpeed_m_s, 0.0f, 1.0f);
+  return glm::mix(glm::vec3(0.2f, 0.95f, 0.3f), glm::vec3(1.0f, 0.15f, 0.1f), t);
+}
+
+}  // namespace
+
+OverlayHistory::OverlayHistory(const CrowdSession& session, size_t capacity)
+    : capacity_(std::max<size_t>(capacity, 1)) {
+  const Skeleton& sk = *session.library().skeleton;
+  const LocomotionLibrary& lib = session.library();
+  for (int s = 0; s < 2; ++s) {
+    toe_joint_[s] = sk.toe(static_cast<Side>(s));
+    if (toe_joint_[s] < 0) toe_joint_[s] = sk.ankle(static_cast<Side>(s));
+    toe_floor_m_[s] = lib.toe_floor_m[s];
+  }
+  slot_id_.assign(capacity_, -1);
+  count_.assign(capacity_, 0);
+  toes_.assign(capacity_ * 2 * kTrailLength, ToeSample{glm::vec3(0.0f), -1.0f});
+  path_.assign(capacity_ * kPathLength, glm::vec3(0.0f));
+}
+
+void OverlayHistory::record(const CrowdSession& session, const AnimationLane& lane, float dt_s) {
+  const AgentFrame& frame = session.frame();
+  const AnimationPlans& plans = lane.mediator->plans();
+  // METRICS.md's contact test, against the library's flat-foot toe height.
+  constexpr float kContactTolerance_m = 0.025f;
+  double slide_sum = 0.0;
+  int samples = 0, skates = 0;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const size_t slot = static_cast<size_t>(plans.slot_of_agent[i]);
+    if (slot >= capacity_) continue;
+    if (slot_id_[slot] != frame.ids[i]) slot_id_[slot] = frame.ids[i], count_[slot] = 0;
+    const int k = count_[slot];
+    const auto world = lane.poses->world(static_cast<int>(slot));
+    for (int s = 0; s < 2; ++s) {
+      if (toe_joint_[s] < 0) continue;
+      const glm::vec3 p(world[toe_joint_[s]][3]);
+      ToeSample* ring = &toes_[(slot * 2 + s) * kTrailLength];
+      ToeSample& cur = ring[k % kTrailLength];
+      const ToeSample& prev = ring[(k + kTrailLength - 1) % kTrailLength];
+      const bool contact = p.y <= toe_floor_m_[s] + kContactTolerance_m;
+      float slide = contact ? 0.0f : -1.0f;
+      if (contact && k > 0 && prev.slide_m_s >= 0.0f) {
+        slide = glm::length(glm::vec2(p.x - prev.position.x, p.z - prev.position.z)) / dt_s;
+        slide_sum += slide;
+        ++samples;
+        if (slide > kSkateSpeed_m_s) ++skates;
+      }
+      cur = {p, slide};
+    }
+    if (k % kPathEvery == 0) {
+      const glm::vec2 r = plans.root_xz[slot];
+      path_[slot * kPathLength + (k / kPathEvery) % kPathLength] = glm::vec3(r.x, 0.02f, r.y);
+    }
+    ++count_[slot];
+  }
+  last_slide_m_s_ = samples ? static_cast<float>(slide_sum / samples) : 0.0f;
+  last_skate_ratio_ = samples ? static_cast<float>(skates) / samples : 0.0f;
+}
+
+void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane,
+                          const OverlayToggles& t, int64_t selected_id, CrowdRenderer* r) const {
+  const AgentFrame& frame = session.frame();
+  const AnimationPlans& plans = lane.mediator->plans();
+  const PoseSynthesizer& poses = *lane.poses;
+  const FootLocks& locks = poses.foot_locks();
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const size_t slot = static_cast<size_t>(plans.slot_of_agent[i]);
+    if (slot >= capacity_) continue;
+    const glm::vec2 root = plans.root_xz[slot];
+    const glm::vec3 ground(root.x, 0.03f, root.y);
+    if (t.velocity) {
+      const glm::vec2 v = frame.velocities[i];
+      const float speed = glm::length(v);
+      if (speed > 1e-3f) {
+        arrow(r, ground, glm::vec3(v.x, 0, v.y) / speed, 0.5f * speed, {0.2f, 0.9f, 0.3f});
+      }
+    }
+    if (t.theta) {
+      arrow(r, ground + glm::vec3(0, 1.95f, 0), heading_dir(frame.thetas[i]), 0.6f,
+            {1.0f, 0.85f, 0.1f});
+    }
+    if (t.facing) {
+      const int s = static_cast<int>(slot);
+      arrow(r, ground + glm::vec3(0, 0.95f, 0), heading_dir(poses.pelvis_heading(s)), 0.55f,
+            {0.25f, 0.55f, 1.0f});
+      arrow(r, ground + glm::vec3(0, 1.45f, 0), heading_dir(poses.upper_heading(s)), 0.55f,
+            {1.0f, 0.5f, 0.1f});
+    }
+    if (t.planted) {
+      for (int s = 0; s < 2; ++s) {
+        const size_t k = slot * 2 + s;
+        if (static_cast<FootLockState>(locks.state[k]) == FootLockState::kLocked) {
+          cross(r, locks.target[k] * glm::vec3(1, 0, 1) + glm::vec3(0, 0.01f, 0), 0.12f,
+                {1.0f, 1.0f, 1.0f});
+        }
+      }
+    }
+    const int n = count_[slot];
+    if (t.trails) {
+      for (int s = 0; s < 2; ++s) {
+        const ToeSample* ring = &toes_[(slot * 2 + s) * kTrailLength];
+        const int m = std::min(n, kTrailLength);
+        for (int j = n - m + 1; j < n; ++j) {
+          const ToeSample& a = ring[(j - 1) % kTrailLength];
+          const ToeSample& b = ring[j % kTrailLength];
+          if (b.slide_m_s < 0.0f || a.slide_m_s < 0.0f) continue;
+          const glm::vec3 pa(a.position.x, 0.015f, a.position.z);
+          const glm::vec3 pb(b.position.x, 0.015f, b.position.z);
+          const glm::vec3 c = slide_color(b.slide_m_s);
+          // A footprint tick at every contact sample, plus the slide itself.
+          cross(r, pb, 0.04f, c);
+          r->add_line(pa, pb, c);
+        }
+      }
+    }
+    if (t.paths) {
+      const int m = std::min((n + kPathEvery - 1) / kPathEvery, kPathLength);
+      const int last = (n - 1) / kPathEvery;
+      for (int j = last - m + 2; j <= last; ++j) {
+        r->add_line(path_[slot * kPathLength + (j - 1) % kPathLength],
+                    path_[slot * kPathLength + j % kPathLength], {0.45f, 0.35f, 0.9f});
+      }
+    }
+    if (selected_id >= 0 && frame.ids[i] == selected_id) {
+      constexpr int kSegments = 24;
+      for (int k = 0; k < kSegments; ++k) {
+        const float a0 = 6.2831853f * k / kSegments, a1 = 6.2831853f * (k + 1) / kSegments;
+        r->add_line(ground + 0.5f * glm::vec3(std::cos(a0), 0, std::sin(a0)),
+                    ground + 0.5f * glm::vec3(std::cos(a1), 0, std::sin(a1)), {1.0f, 0.2f, 0.9f});
+      }
+    }
+  }
+}
+
+}  // namespace gk::app

@@ -1,0 +1,62 @@
+#pragma once
+// Teaching overlays drawn with CrowdRenderer::add_line: what the simulator asks (velocity v,
+// torso orientation theta), what the body does (lower/upper body facing), planted feet (the pose
+// synthesizer's foot locks), foot trails coloured by slide speed, and the agents' recent paths.
+// Histories are ring buffers per mediator slot sized at creation: recording allocates nothing.
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "app/crowd_session.h"
+#include "render/crowd_renderer.h"
+
+namespace gk::app {
+
+struct OverlayToggles {
+  bool velocity = false;  // v from the simulator (green, on the ground, 0.5 s of travel)
+  bool theta = false;     // desired torso orientation (yellow, above the head)
+  bool facing = false;    // lower body = pelvis (blue, hip height), upper body = chest (orange)
+  bool planted = false;   // locked feet: crosses at the lock targets (white)
+  bool trails = false;    // toe positions while on the ground, green (still) .. red (>= 30 cm/s)
+  bool paths = false;     // root path of the last 4 s (violet)
+  bool any() const { return velocity || theta || facing || planted || trails || paths; }
+};
+
+// Slide speed [m/s] from which a trail sample is fully red: METRICS.md's skate threshold.
+inline constexpr float kSkateSpeed_m_s = 0.30f;
+
+class OverlayHistory {
+ public:
+  OverlayHistory(const CrowdSession& session, size_t capacity);
+  // Appends this frame's toe and root positions of every live agent of the lane.
+  void record(const CrowdSession& session, const AnimationLane& lane, float dt_s);
+  // Mean slide speed of the feet in contact on the last recorded frame [m/s] (both this frame and
+  // the previous one in contact, METRICS.md's test), and the share of them above kSkateSpeed_m_s.
+  float last_slide_m_s() const { return last_slide_m_s_; }
+  float last_skate_ratio() const { return last_skate_ratio_; }
+  // Queues the enabled overlays as debug lines. `selected_id` (or -1) gets a ring at its feet.
+  void draw(const CrowdSession& session, const AnimationLane& lane, const OverlayToggles& toggles,
+            int64_t selected_id, CrowdRenderer* renderer) const;
+
+ private:
+  static constexpr int kTrailLength = 90;  // samples of each toe (1.5 s at 60 Hz)
+  static constexpr int kPathLength = 60;   // root samples, one every kPathEvery frames
+  static constexpr int kPathEvery = 4;
+  struct ToeSample {
+    glm::vec3 position;
+    float slide_m_s;  // < 0: not in contact
+  };
+  size_t capacity_;
+  float last_slide_m_s_ = 0.0f;
+  float last_skate_ratio_ = 0.0f;
+  int toe_joint_[2] = {-1, -1};
+  float toe_floor_m_[2] = {0.0f, 0.0f};
+  std::vector<int64_t> slot_id_;  // id recorded in the slot, -1 when empty
+  std::vector<int> count_;        // samples recorded since the slot's agent appeared
+  std::vector<ToeSample> toes_;   // [(slot * 2 + side) * kTrailLength + k]
+  std::vector<glm::vec3> path_;   // [slot * kPathLength + k]
+};
+
+}  // namespace gk::app

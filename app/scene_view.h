@@ -1,0 +1,42 @@
+#pragma once
+// The 3D view of a CrowdSession: a CrowdRenderer with the session's mesh and walls, an orbit
+// camera, and drawing of one lane or of a split screen (compare lane left, primary lane right).
+// Needs a current GL context for every call, including destruction.
+
+#include <memory>
+
+#include <glm/vec2.hpp>
+
+#include "app/crowd_session.h"
+#include "common/status.h"
+#include "render/camera.h"
+#include "render/crowd_renderer.h"
+
+namespace gk::app {
+
+// A 3/4 view (yaw 35 deg, pitch 40 deg) that fits the ground box [lo, hi] into the viewport.
+OrbitCamera frame_bounds(glm::vec2 lo, glm::vec2 hi, glm::ivec2 viewport_px);
+
+class SceneView {
+ public:
+  // Builds the renderer and uploads the session's mesh and walls.
+  static Result<std::unique_ptr<SceneView>> create(const CrowdSession& session);
+
+  // Uploads one lane's palettes (the `upload` stage).
+  Status upload(const CrowdSession& session, const AnimationLane& lane);
+  // Draws the uploaded lane into a rectangle (GL origin bottom-left); `camera_viewport` is the
+  // size the camera's aspect is computed for.
+  Status draw(const AnimationLane& lane, glm::ivec2 origin_px, glm::ivec2 size_px);
+  // Everything for one frame: the primary lane over the whole viewport, or with the session's
+  // compare lane the split screen (compare left, primary right, same camera).
+  Status render(const CrowdSession& session, glm::ivec2 viewport_px, bool split);
+
+  OrbitCamera& camera() { return camera_; }
+  CrowdRenderer& renderer() { return *renderer_; }
+
+ private:
+  std::unique_ptr<CrowdRenderer> renderer_;
+  OrbitCamera camera_;
+};
+
+}  // namespace gk::app
