@@ -45,7 +45,7 @@ constexpr float kMaxStepSpeed = 1.5f;  // [m/s] a released foot travels back no 
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
 // kMaxDrop, and comes back up at kDropRecovery.
 constexpr float kDropReach = 0.99f;
-constexpr float kMaxDrop = 0.08f;       // [m]
+constexpr float kMaxDrop = 0.04f;          // [m]
 constexpr float kDropRecovery = 0.25f;  // [m/s]
 
 float smoothstep01(float x) {
