@@ -42,6 +42,16 @@ float wrap_angle(float a) {
   return a - kPi;
 }
 
+// Model-space transforms of one clip frame (no placement).
+void frame_model(const Clip& c, const Skeleton& sk, int f, std::vector<glm::mat4>& model) {
+  LocalToModelJob{&sk,
+                  {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
+                  {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
+                  glm::mat4(1.0f),
+                  model}
+      .run();
+}
+
 std::vector<glm::mat4> rest_model(const Skeleton& sk) {
   std::vector<glm::mat4> m(sk.num_joints());
   LocalToModelJob{&sk, sk.rest_rotations, sk.rest_translations, glm::mat4(1.0f), m}.run();
@@ -63,12 +73,7 @@ Clip make_in_place(const Clip& src, const Skeleton& sk, const ClipAnalysis& a, f
   std::vector<glm::mat4> model(nj);
   std::vector<glm::vec3> hips_xz(n);
   for (int f = 0; f < n; ++f) {
-    LocalToModelJob{&sk,
-                    {c.frame_rotations(f), static_cast<size_t>(nj)},
-                    {c.frame_translations(f), static_cast<size_t>(nj)},
-                    glm::mat4(1.0f),
-                    model}
-        .run();
+    frame_model(c, sk, f, model);
     hips_xz[f] = translation_of(model[hips]);
     hips_xz[f].y = 0.0f;
   }
@@ -94,12 +99,7 @@ float clip_facing(const Clip& c, const Skeleton& sk) {
   std::vector<glm::mat4> model(sk.num_joints());
   glm::vec3 sum(0.0f);
   for (int f = 0; f < c.num_frames; ++f) {
-    LocalToModelJob{&sk,
-                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
-                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
-                    glm::mat4(1.0f),
-                    model}
-        .run();
+    frame_model(c, sk, f, model);
     const glm::vec3 lr =
         translation_of(model[sk.hip(Side::kLeft)]) - translation_of(model[sk.hip(Side::kRight)]);
     sum += glm::cross(lr, glm::vec3(0, 1, 0));
@@ -160,12 +160,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
   std::vector<glm::mat4> model(sk.num_joints());
   std::vector<glm::vec3> toe[2], ankle[2];
   for (int f = 0; f < n; ++f) {
-    LocalToModelJob{&sk,
-                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
-                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
-                    glm::mat4(1.0f),
-                    model}
-        .run();
+    frame_model(c, sk, f, model);
     for (int s = 0; s < 2; ++s) {
       toe[s].push_back(translation_of(model[sk.toe(static_cast<Side>(s))]));
       ankle[s].push_back(translation_of(model[sk.ankle(static_cast<Side>(s))]));
@@ -232,12 +227,7 @@ LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
   int best = 0;
   float best_score = 1e9f;
   for (int f = 0; f < g.num_frames; ++f) {
-    LocalToModelJob{&sk,
-                    {g.frame_rotations(f), static_cast<size_t>(g.num_joints)},
-                    {g.frame_translations(f), static_cast<size_t>(g.num_joints)},
-                    glm::mat4(1.0f),
-                    model}
-        .run();
+    frame_model(g, sk, f, model);
     glm::vec3 d =
         translation_of(model[sk.toe(Side::kLeft)]) - translation_of(model[sk.toe(Side::kRight)]);
     const float planted = gait.toe_height_m[0][f] + gait.toe_height_m[1][f] +

@@ -14,28 +14,14 @@
 #include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
+#include "tests/app/cli_support.h"
 #include "tests/test_data.h"
 
 namespace gk {
 namespace {
 
-struct CommandResult {
-  int code = -1;
-  std::string out;  // stdout and stderr
-};
-
-CommandResult run(const std::string& args) {
-  CommandResult r;
-  const std::string cmd = std::string(GK_GAITKEEPER_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::CommandResult;
+CommandResult run(const std::string& args) { return test::run_gaitkeeper(args); }
 
 nlohmann::json read_json(const std::string& path) {
   std::ifstream in(path);
