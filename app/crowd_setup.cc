@@ -66,7 +66,8 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
                   "geometry grows to keep its spawn density");
   cmd->add_option("--seed", o->seed, "Seed of the agents' spawn positions, speeds, goals");
   cmd->add_option("--threads", o->threads,
-                  "Threads of the simulator (1 = single-threaded, default; 0 = all cores)");
+                  "Worker threads of the simulator, mediator and pose passes (1 = single-threaded, "
+                  "default; 0 = all cores)");
   cmd->add_option("--trajectory-frame-time", o->trajectory_frame_time,
                   "Seconds between two samples of a replayed trajectory (default 0.4)");
   cmd->add_option("--mode", o->mode,
