@@ -11,7 +11,7 @@ if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libglfw3-dev libimgui-dev libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libgles-dev
+  libglfw3-dev libimgui-dev libgl-dev libopengl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libgles-dev
   libcli11-dev libtbb-dev librecast-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth ffmpeg jq
