@@ -259,7 +259,24 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   const float speed = glm::length(vel);
   const float theta = wrap_pi(theta_[slot]);
   const bool standing = speed < P.stop_speed_m_s;
-  const float travel = standing ? pl.lower_yaw[slot] : heading2(vel);
+  // 8. The root follows p: predicted with the filtered velocity and pulled onto p, so a simulator's
+  // frame-to-frame jitter (velocity flips in a jam) does not shake the body, while a steady walk
+  // is tracked without lag. Never more than kMaxRootOffset from p. The legs then walk where the
+  // drawn root really goes.
+  glm::vec2 root_vel = vel;
+  if (apm && !pl.fresh[slot]) {
+    const glm::vec2 predicted = pl.root_xz[slot] + vel * dt;
+    glm::vec2 root = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
+    const glm::vec2 off = root - p;
+    const float len = glm::length(off);
+    if (len > kMaxRootOffset) root = p + off * (kMaxRootOffset / len);
+    root_vel = (root - pl.root_xz[slot]) / dt;
+    pl.root_xz[slot] = root;
+  } else {
+    pl.root_xz[slot] = p;
+  }
+  const float travel =
+      standing ? pl.lower_yaw[slot] : heading2(glm::length(root_vel) > 1e-3f ? root_vel : vel);
 
   // 2./3. Lower body follows v (or a strafe/backward orientation), upper body faces theta.
   float psi = pl.lower_yaw[slot];
@@ -401,19 +418,6 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     }
   }
 
-  // 8. The root follows p: predicted with the filtered velocity and pulled onto p, so a simulator's
-  // frame-to-frame jitter (velocity flips in a jam) does not shake the body, while a steady walk
-  // is tracked without lag. Never more than kMaxRootOffset from p.
-  if (apm && !pl.fresh[slot]) {
-    const glm::vec2 predicted = pl.root_xz[slot] + vel * dt;
-    glm::vec2 root = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
-    const glm::vec2 off = root - p;
-    const float len = glm::length(off);
-    if (len > kMaxRootOffset) root = p + off * (kMaxRootOffset / len);
-    pl.root_xz[slot] = root;
-  } else {
-    pl.root_xz[slot] = p;
-  }
   pl.lower_yaw[slot] = psi;
   pl.upper_yaw[slot] = apm ? theta : psi;
   pl.travel_yaw[slot] = wrap_pi(psi + (gait_w > 0.0f ? std::atan2(dir_sum.x, dir_sum.y) : 0.0f));
