@@ -5,8 +5,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "crowd/scenario.h"
-#include "crowd/social_forces.h"
+#include "bench/plaza_crowd.h"
 
 namespace {
 
@@ -14,20 +13,7 @@ constexpr float kDt = 1.0f / 60.0f;
 
 void BM_SocialForcesStep(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  auto loaded = gk::load_scenario_by_name("plaza", gk::scenario_dir());
-  if (!loaded.ok()) {
-    state.SkipWithError(loaded.message().c_str());
-    return;
-  }
-  const gk::Scenario scenario = gk::scale_scenario(*loaded, n);
-  auto agents = gk::expand_agents(scenario, n, 1);
-  if (!agents.ok()) {
-    state.SkipWithError(agents.message().c_str());
-    return;
-  }
-  gk::SocialForceParams params;
-  params.threads = static_cast<int>(state.range(1));
-  auto sim = gk::SocialForces::create(scenario, *agents, params);
+  auto sim = gk::bench::make_plaza_crowd(n, static_cast<int>(state.range(1)));
   if (!sim.ok()) {
     state.SkipWithError(sim.message().c_str());
     return;

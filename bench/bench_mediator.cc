@@ -10,8 +10,7 @@
 
 #include "animation/clip_library.h"
 #include "animation/procedural.h"
-#include "crowd/scenario.h"
-#include "crowd/social_forces.h"
+#include "bench/plaza_crowd.h"
 #include "mediator/mediator.h"
 #include "mediator/pose_synthesis.h"
 
@@ -43,11 +42,6 @@ gk::Result<gk::LocomotionLibrary> library(int which) {
   return gk::build_locomotion_library(sets);
 }
 
-struct Fixture {
-  gk::LocomotionLibrary lib;
-  std::unique_ptr<gk::SocialForces> sim;
-};
-
 void BM_MediatorAndPose(benchmark::State& state) {
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const int n = 1000;
@@ -56,16 +50,9 @@ void BM_MediatorAndPose(benchmark::State& state) {
     state.SkipWithError(lib.message().c_str());
     return;
   }
-  auto loaded = gk::load_scenario_by_name("plaza", gk::scenario_dir());
-  if (!loaded.ok()) {
-    state.SkipWithError(loaded.message().c_str());
-    return;
-  }
-  const gk::Scenario scenario = gk::scale_scenario(*loaded, n);
-  auto agents = gk::expand_agents(scenario, n, 1);
-  auto sim = gk::SocialForces::create(scenario, *agents, gk::SocialForceParams{});
-  if (!agents.ok() || !sim.ok()) {
-    state.SkipWithError("plaza scenario could not be created");
+  auto sim = gk::bench::make_plaza_crowd(n, 1);
+  if (!sim.ok()) {
+    state.SkipWithError(sim.message().c_str());
     return;
   }
   gk::CrowdSource& crowd = **sim;
@@ -90,7 +77,9 @@ void BM_MediatorAndPose(benchmark::State& state) {
       static_cast<double>(state.iterations()) * n,
       benchmark::Counter::kIsRate | benchmark::Counter::kInvert, benchmark::Counter::kIs1000);
   state.SetLabel(std::string(state.range(1) == 1 ? "pose" : "mediator") + ", " +
-                 (state.range(0) == 0 ? "built-in" : state.range(0) == 1 ? "CMU" : "mannequin"));
+                 (state.range(0) == 0   ? "built-in"
+                  : state.range(0) == 1 ? "CMU"
+                                        : "mannequin"));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "animation/pose_jobs.h"
+#include "mediator/springs.h"
 
 namespace gk {
 namespace {
@@ -34,12 +35,6 @@ bool name_excluded(const std::string& name) {
     if (n.find(k) != std::string::npos) return true;
   }
   return false;
-}
-
-float wrap_angle(float a) {
-  a = std::fmod(a + kPi, 2.0f * kPi);
-  if (a < 0.0f) a += 2.0f * kPi;
-  return a - kPi;
 }
 
 // Model-space transforms of one clip frame (no placement).
@@ -365,9 +360,9 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   for (int i = 0; i < static_cast<int>(lib.clips.size()); ++i) {
     float d = lib.clips[i].direction_rad;
     for (float snap : {0.0f, kPi / 2, -kPi / 2, kPi}) {
-      if (std::abs(wrap_angle(d - snap)) < glm::radians(30.0f)) d = snap == -kPi ? kPi : snap;
+      if (std::abs(wrap_pi(d - snap)) < glm::radians(30.0f)) d = snap == -kPi ? kPi : snap;
     }
-    if (std::abs(wrap_angle(d - kPi)) < 1e-4f) d = kPi;
+    if (std::abs(wrap_pi(d - kPi)) < 1e-4f) d = kPi;
     auto it = std::find_if(lib.groups.begin(), lib.groups.end(), [&](const DirectionGroup& g) {
       return std::abs(g.direction_rad - d) < 1e-4f;
     });
