@@ -343,7 +343,8 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
   glm::mat4 placed = root;
   if (drop > 0.0f) {
     placed[3].y -= drop;
-    fk_from(slot, 0, placed);
+    // Lowering the root lowers every joint by the same amount: no need for a second FK pass.
+    for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
     // Free feet go down with the body; pinned ones stay where they are pinned.
     for (int side = 0; side < 2; ++side) {
       if (pinned[side]) toe_offset[side].y += drop;
