@@ -36,10 +36,12 @@ constexpr float kPlantSpeed = 0.5f;  // [m/s]
 // A planted foot is held until its toe or ankle clearly lifts (heel-off pivots on the ball).
 constexpr float kHoldToe = 0.045f;
 constexpr float kHoldAnkle = 0.09f;
-// A free foot moving faster than kPlantSpeed low over the ground is lifted to this clearance so it
-// swings instead of dragging; fully from kClearSpeed on.
+// A foot that is not pinned and moves faster than kLiftSpeed low over the ground is lifted to
+// kClearance so it swings instead of dragging; fully from kClearSpeed on. METRICS.md counts a toe
+// within 2.5 cm of its lowest height as in contact, and 30 cm/s as skating.
 constexpr float kClearance = 0.045f;
-constexpr float kClearSpeed = 0.6f;    // [m/s]
+constexpr float kLiftSpeed = 0.2f;     // [m/s]
+constexpr float kClearSpeed = 0.3f;    // [m/s]
 constexpr float kMaxLiftSpeed = 1.5f;  // [m/s] fastest change of that lift
 constexpr float kMaxStepSpeed = 1.5f;  // [m/s] a released foot travels back no faster on average
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
@@ -97,6 +99,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.timer.assign(capacity * 2, 0.0f);
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.lift.assign(capacity * 2, 0.0f);
+  locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J] {
     Scratch s;
@@ -237,12 +240,16 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
       state = FootLockState::kFree;
       weight = 0.0f;
       locks_.lift[k] = 0.0f;
+      locks_.drawn_toe[k] = anim_toe;
     }
+    const glm::vec3 drawn_before = locks_.drawn_toe[k];
     switch (state) {
       case FootLockState::kFree:
         if (planted) {
+          // Pinned where it was drawn last frame: the foot stops on the frame it plants instead
+          // of taking one more step of the clip's (still slowing) foot.
           state = FootLockState::kLocked;
-          target = anim_toe;
+          target = glm::vec3(drawn_before.x, anim_toe.y, drawn_before.z);
           weight = 1.0f;
         }
         break;
@@ -306,11 +313,18 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
         break;
       }
     }
-    // A free foot skimming the ground fast is lifted clear (continuous in height and speed).
+    // A free or released foot skimming the ground fast is lifted clear (continuous in height and
+    // speed). The speed is that of the foot as it will be drawn, from where it was drawn.
     float lift = 0.0f;
-    if (state == FootLockState::kFree && ankle_h <= kHoldAnkle) {
-      const float fast = smoothstep01((ground_speed - kPlantSpeed) / (kClearSpeed - kPlantSpeed));
-      lift = std::max(0.0f, kClearance - toe_h) * fast;
+    if ((state == FootLockState::kFree || state == FootLockState::kReleasing) &&
+        ankle_h <= kHoldAnkle) {
+      const glm::vec3 goal = glm::mix(anim_toe, target, weight);
+      const float speed = pl.fresh[slot] ? 0.0f
+                                         : std::hypot(goal.x - drawn_before.x,
+                                                      goal.z - drawn_before.z) / dt;
+      const float fast = smoothstep01((speed - kLiftSpeed) / (kClearSpeed - kLiftSpeed));
+      const float h = goal.y - drop_[slot] - library_.toe_floor_m[side];
+      lift = std::max(0.0f, kClearance - h) * fast;
     }
     // Rate-limited so the knee never snaps (a pop) when the foot speeds up through the band.
     const float max_change = kMaxLiftSpeed * dt;
@@ -323,6 +337,10 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
   }
   if (!use_ik[0] && !use_ik[1]) {
     drop_[slot] = 0.0f;
+    for (int side = 0; side < 2; ++side) {
+      locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
+          translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+    }
     return;
   }
   // Pelvis drop: a pinned foot the leg cannot reach pulls the whole body down (up to kMaxDrop)
@@ -396,6 +414,10 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
   }
   fk_from(slot, std::min(skeleton_.ankle(Side::kLeft), skeleton_.ankle(Side::kRight)), placed);
+  for (int side = 0; side < 2; ++side) {
+    locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
+        translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+  }
 }
 
 }  // namespace gk

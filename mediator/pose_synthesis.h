@@ -28,6 +28,7 @@ struct FootLocks {
   std::vector<float> timer;         // stepping progress [s]
   std::vector<glm::vec3> anim_toe;  // the clip's (unlocked) toe position last frame
   std::vector<float> lift;          // swing clearance lift applied last frame [m]
+  std::vector<glm::vec3> drawn_toe; // the toe as drawn last frame (after IK) [m]
 };
 
 class PoseSynthesizer {
