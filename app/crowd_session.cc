@@ -110,9 +110,9 @@ Status CrowdSession::step(double dt_s) {
   frame_ = crowd.frame();
   times_.sim_ms = ms_since(t);
   t = Clock::now();
-  GK_RETURN_IF_ERROR(primary_.mediator->plan(frame_, dt));
+  GK_RETURN_IF_ERROR(primary_.mediator->plan(frame_, dt, crowd.feedback_policy()));
   GK_RETURN_IF_ERROR(crowd.apply_feedback(primary_.mediator->feedback().view(frame_.size())));
-  if (compare_) GK_RETURN_IF_ERROR(compare_->mediator->plan(frame_, dt));
+  if (compare_) GK_RETURN_IF_ERROR(compare_->mediator->plan(frame_, dt, crowd.feedback_policy()));
   times_.mediator_ms = ms_since(t);
   t = Clock::now();
   primary_.poses->run(*primary_.mediator, dt);

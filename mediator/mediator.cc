@@ -169,7 +169,7 @@ void Mediator::choose_weights(int slot, float speed, float rel_dir, float* w) co
   add_group_weights(lib, groups[hi], speed, u, w);
 }
 
-Status Mediator::plan(const AgentFrame& frame, float dt_s) {
+Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy) {
   if (!(dt_s > 0.0f) || !std::isfinite(dt_s) || dt_s > 1.0f) {
     return Status::Error("mediator: frame time must be in (0, 1] s, got " + std::to_string(dt_s));
   }
@@ -215,10 +215,11 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s) {
   for (size_t i = 0; i < n; ++i)
     plans_.agent_of_slot[plans_.slot_of_agent[i]] = static_cast<int32_t>(i);
 
+  const bool feedback = params_.feedback && policy == FeedbackPolicy::kHonoured;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       plan_agent(static_cast<int>(i), plans_.slot_of_agent[i], frame.positions[i],
-                 frame.velocities[i], frame.thetas[i], dt_s);
+                 frame.velocities[i], frame.thetas[i], dt_s, feedback);
     }
   });
   for (size_t i = 0; i < n; ++i) {
@@ -232,7 +233,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s) {
 }
 
 void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm::vec2& v_in,
-                          float theta_in, float dt) {
+                          float theta_in, float dt, bool feedback) {
   const LocomotionLibrary& lib = library_;
   const MediatorParams& P = params_;
   const size_t nc = lib.clips.size();
@@ -401,13 +402,26 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   feedback_.positions[a] = p;
   feedback_.velocities[a] = v;
   feedback_.thetas[a] = theta_raw;
-  if (apm && P.feedback) {
+  if (apm && feedback) {
     const DirectionGroup& fg = lib.groups[lib.forward_group];
     const float max_speed =
         lib.clips[fg.clips.back()].speed_m_s * P.max_playback_rate * (1.0f + P.max_stride_warp);
     const float v_len = glm::length(v);
     if (v_len > max_speed) {
       feedback_.velocities[a] = v * (max_speed / v_len);
+      feedback_.has_feedback[a] = 1;
+    }
+    // The legs turn at a limited rate: a velocity that turns faster than they can is turned back
+    // to within turn_feedback_deg of the direction they walk this frame, so the simulator moves
+    // the agent where its feet go (a jam's sideways jitter would otherwise look like skating).
+    const float walked = wrap_pi(psi + (gait_w > 0.0f ? std::atan2(dir_sum.x, dir_sum.y) : 0.0f));
+    const glm::vec2 v_out = feedback_.velocities[a];
+    const float v_out_len = glm::length(v_out);
+    const float off = wrap_pi(heading2(v_out) - walked);
+    const float slack = glm::radians(P.turn_feedback_deg);
+    if (!standing && gait_w > 0.0f && v_out_len > P.stop_speed_m_s && std::abs(off) > slack) {
+      const float dir = walked + std::clamp(off, -slack, slack);
+      feedback_.velocities[a] = v_out_len * glm::vec2(std::sin(dir), std::cos(dir));
       feedback_.has_feedback[a] = 1;
     }
     const float twist = wrap_pi(theta_raw - psi);

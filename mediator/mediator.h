@@ -64,8 +64,10 @@ class Mediator {
   Mediator(const LocomotionLibrary& library, const MediatorParams& params, size_t capacity);
 
   // Plans every live agent of the frame for a step of dt_s [s]. Bad simulator values (NaN, absurd
-  // speeds) are sanitised per agent and counted, never propagated.
-  Status plan(const AgentFrame& frame, float dt_s);
+  // speeds) are sanitised per agent and counted, never propagated. A source that ignores feedback
+  // (recorded data) is asked for none: feedback() then holds the frame's own values, unflagged.
+  Status plan(const AgentFrame& frame, float dt_s,
+              FeedbackPolicy policy = FeedbackPolicy::kHonoured);
 
   const AnimationPlans& plans() const { return plans_; }
   const FeedbackBuffers& feedback() const { return feedback_; }
@@ -82,7 +84,7 @@ class Mediator {
  private:
   void init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta);
   void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
-                  float dt);
+                  float dt, bool feedback);
   void choose_weights(int slot, float speed, float rel_dir, float* out_w) const;
 
   const LocomotionLibrary& library_;

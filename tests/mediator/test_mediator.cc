@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "animation/pose_jobs.h"
+#include "mediator/springs.h"
 #include "tests/mediator/mediator_fixture.h"
 
 namespace gk {
@@ -93,6 +94,38 @@ TEST(Mediator, FeedsBackTheSpeedItCanDeliver) {
   ASSERT_TRUE(r.report.feedback_speed_change.has_value());
   EXPECT_NEAR(*r.report.feedback_speed_change, 1.0 - 3.6 * 1.35 * 1.2 / 9.0, 0.01);
   EXPECT_EQ(r.feedback_frames, 120);
+}
+
+TEST(Mediator, FeedsBackAWalkingDirectionTheLegsCanTake) {
+  // Walking +z at 1.3 m/s, the simulator turns the velocity to +x in one frame (a jam's jitter).
+  // The legs turn at lower_turn_rate_deg_s, so the velocity fed back stays within
+  // turn_feedback_deg of where they walk, and reaches +x once they have turned.
+  const LocomotionLibrary& lib = builtin_library();
+  MediatorParams p;
+  Mediator m(lib, p, 1);
+  const float dt = 1.0f / 60.0f;
+  const uint32_t id = 5;
+  glm::vec2 pos(0.0f), vel(0.0f, 1.3f);
+  float theta = 0.0f;
+  int turned_back = 0;
+  float last_dir = 0.0f;
+  for (int f = 0; f < 120; ++f) {
+    if (f == 60) vel = glm::vec2(1.3f, 0.0f);
+    theta = std::atan2(vel.x, vel.y);
+    ASSERT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, dt).ok());
+    const FeedbackBuffers& fb = m.feedback();
+    const glm::vec2 out = fb.velocities[0];
+    const float dir = std::atan2(out.x, out.y);
+    const float walked = m.plans().travel_yaw[m.plans().slot_of_agent[0]];
+    EXPECT_LE(std::abs(wrap_pi(dir - walked)), glm::radians(p.turn_feedback_deg) + 1e-3f) << f;
+    EXPECT_NEAR(glm::length(out), 1.3f, 1e-3f) << f;  // the speed is kept
+    if (fb.has_feedback[0]) ++turned_back;
+    pos += out * dt;  // an honouring simulator moves with the velocity fed back, and asks again
+    last_dir = dir;
+  }
+  EXPECT_GE(turned_back, 3);  // a 90 degree turn at 300 deg/s takes 0.3 s
+  EXPECT_LE(turned_back, 40);
+  EXPECT_NEAR(last_dir, std::numbers::pi_v<float> / 2.0f, glm::radians(p.turn_feedback_deg));
 }
 
 TEST(Mediator, SurvivesNaNAndAbsurdInput) {

@@ -28,7 +28,7 @@ MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, Media
   for (int f = 0; f < kFrames; ++f) {
     EXPECT_TRUE(crowd.step(kDt).ok());
     const AgentFrame frame = crowd.frame();
-    EXPECT_TRUE(mediator.plan(frame, kDt).ok());
+    EXPECT_TRUE(mediator.plan(frame, kDt, crowd.feedback_policy()).ok());
     poses.run(mediator, kDt);
     metrics.record(frame, mediator, poses);
     EXPECT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
