@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "animation/clip_library.h"
+#include "crowd/detour_crowd.h"
 #include "crowd/scenario.h"
 #include "crowd/social_forces.h"
 #include "crowd/trajectory_replay.h"
@@ -36,13 +37,18 @@ MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, Media
   return metrics.finish();
 }
 
-std::unique_ptr<CrowdSource> scenario_crowd(const std::string& name) {
+std::unique_ptr<CrowdSource> scenario_crowd(const std::string& name, bool detour = false) {
   auto loaded = load_scenario_by_name(name, scenario_dir());
   EXPECT_TRUE(loaded.ok()) << loaded.message();
   const int n = loaded->default_agents;
   const Scenario s = scale_scenario(*loaded, n);
   auto agents = expand_agents(s, n, 1);
   EXPECT_TRUE(agents.ok()) << agents.message();
+  if (detour) {
+    auto crowd = make_detour_crowd(s, *agents);
+    EXPECT_TRUE(crowd.ok()) << crowd.message();
+    return std::move(*crowd);
+  }
   auto sim = SocialForces::create(s, *agents, SocialForceParams{});
   EXPECT_TRUE(sim.ok()) << sim.message();
   return std::move(*sim);
@@ -82,6 +88,25 @@ TEST(Quality, GalleryUpperBodyFacesTheExhibits) {
   expect_apm_bounds(apm, run_source(*b, lib, MediatorMode::kNaive), false, "gallery");
   ASSERT_GT(apm.facing_error_within_limit_deg.count, 1000u);
   EXPECT_LE(apm.facing_error_within_limit_deg.p95, 10.0);
+}
+
+// The hardest simulated case: a jam in DetourCrowd (velocities that flip sideways from frame to
+// frame) animated with a library of just two clips by different actors (CMU walk and run).
+TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
+  GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
+  GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
+  std::vector<ClipSet> sets;
+  for (const char* f : {"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"}) {
+    auto set = load_clip_file(test::data_path(f));
+    ASSERT_TRUE(set.ok()) << set.message();
+    sets.push_back(std::move(*set));
+  }
+  auto lib = build_locomotion_library(sets);
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  auto a = scenario_crowd("bottleneck", true);
+  auto b = scenario_crowd("bottleneck", true);
+  expect_apm_bounds(run_source(*a, *lib, MediatorMode::kApm),
+                    run_source(*b, *lib, MediatorMode::kNaive), false, "bottleneck detour cmu");
 }
 
 TEST(Quality, ReplayedPedestriansWithTheMannequinClips) {
