@@ -2,6 +2,9 @@
 // a folder of numbered PNG frames, or an H.264 video streamed into ffmpeg (no temporary files).
 // --compare splits the screen: the naive crowd on the left, the chosen mode on the right, on the
 // same crowd frames.
+#include <unistd.h>
+
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -158,6 +161,7 @@ void run_render(RenderOptions& o) {
   const int label_scale = std::max(2, size.y / 240);
   std::string right_label(mediator_mode_name(session->params().mode));
   for (char& c : right_label) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const bool tty = isatty(fileno(stderr)) != 0;
   for (int f = 0; f < frames; ++f) {
     if (Status s = session->step(kFrameTime_s); !s.ok()) {
       if (video) pclose(video);
@@ -216,12 +220,17 @@ void run_render(RenderOptions& o) {
       if (video) pclose(video);
       fail(kCmd, 1, written.message());
     }
+    // Progress: one updating line on a terminal, a line per tenth in a log.
     if (kind != OutputKind::kPng || f == frames - 1) {
-      std::fprintf(stderr, "\rrender: frame %d/%d   ", f + 1, frames);
-      std::fflush(stderr);
+      if (tty) {
+        std::fprintf(stderr, "\rrender: frame %d/%d   ", f + 1, frames);
+        std::fflush(stderr);
+      } else if (f == frames - 1 || (f + 1) % std::max(1, frames / 10) == 0) {
+        std::fprintf(stderr, "render: frame %d/%d\n", f + 1, frames);
+      }
     }
   }
-  std::fprintf(stderr, "\n");
+  if (tty) std::fprintf(stderr, "\n");
   if (video) {
     const int status = pclose(video);
     if (status != 0)

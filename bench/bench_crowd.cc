@@ -26,10 +26,9 @@ void BM_SocialForcesStep(benchmark::State& state) {
   }
   state.counters["agents"] = n;
   // Seconds per agent and step, printed with an SI prefix (e.g. "433ns").
-  state.counters["sec_per_agent_step"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * n,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert,
-                         benchmark::Counter::kIs1000);
+  state.counters["sec_per_agent_step"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * n,
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert, benchmark::Counter::kIs1000);
 }
 BENCHMARK(BM_SocialForcesStep)
     ->ArgNames({"agents", "threads"})

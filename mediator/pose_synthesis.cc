@@ -47,7 +47,7 @@ constexpr float kMaxStepSpeed = 1.5f;  // [m/s] a released foot travels back no 
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
 // kMaxDrop, and comes back up at kDropRecovery.
 constexpr float kDropReach = 0.99f;
-constexpr float kMaxDrop = 0.04f;          // [m]
+constexpr float kMaxDrop = 0.04f;       // [m]
 constexpr float kDropRecovery = 0.25f;  // [m/s]
 
 float smoothstep01(float x) {
@@ -319,9 +319,8 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     if ((state == FootLockState::kFree || state == FootLockState::kReleasing) &&
         ankle_h <= kHoldAnkle) {
       const glm::vec3 goal = glm::mix(anim_toe, target, weight);
-      const float speed = pl.fresh[slot] ? 0.0f
-                                         : std::hypot(goal.x - drawn_before.x,
-                                                      goal.z - drawn_before.z) / dt;
+      const float speed =
+          pl.fresh[slot] ? 0.0f : std::hypot(goal.x - drawn_before.x, goal.z - drawn_before.z) / dt;
       const float fast = smoothstep01((speed - kLiftSpeed) / (kClearSpeed - kLiftSpeed));
       const float h = goal.y - drop_[slot] - library_.toe_floor_m[side];
       lift = std::max(0.0f, kClearance - h) * fast;
