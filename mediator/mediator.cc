@@ -411,16 +411,19 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
       feedback_.velocities[a] = v * (max_speed / v_len);
       feedback_.has_feedback[a] = 1;
     }
-    // The legs turn at a limited rate: a velocity that turns faster than they can is turned back
-    // to within turn_feedback_deg of the direction they walk this frame, so the simulator moves
-    // the agent where its feet go (a jam's sideways jitter would otherwise look like skating).
-    const float walked = wrap_pi(psi + (gait_w > 0.0f ? std::atan2(dir_sum.x, dir_sum.y) : 0.0f));
+    // With forward clips only, the legs walk where the lower body faces, and it turns at a
+    // limited rate: a velocity that turns faster is turned back to within turn_feedback_deg of
+    // that facing, so the simulator moves the agent where its feet go (a jam's sideways jitter
+    // would otherwise look like skating). A library with strafe or backward clips takes sideways
+    // velocities by blending directions instead (and its facing may be mid-switch between
+    // direction groups, which is no direction to hold the simulator to).
     const glm::vec2 v_out = feedback_.velocities[a];
     const float v_out_len = glm::length(v_out);
-    const float off = wrap_pi(heading2(v_out) - walked);
+    const float off = wrap_pi(heading2(v_out) - psi);
     const float slack = glm::radians(P.turn_feedback_deg);
-    if (!standing && gait_w > 0.0f && v_out_len > P.stop_speed_m_s && std::abs(off) > slack) {
-      const float dir = walked + std::clamp(off, -slack, slack);
+    if (!lib.has_direction_clips() && !standing && gait_w > 0.0f && v_out_len > P.stop_speed_m_s &&
+        std::abs(off) > slack) {
+      const float dir = psi + std::clamp(off, -slack, slack);
       feedback_.velocities[a] = v_out_len * glm::vec2(std::sin(dir), std::cos(dir));
       feedback_.has_feedback[a] = 1;
     }

@@ -138,7 +138,10 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   const MediatorParams& P = m.params();
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
-  if (pl.fresh[slot]) has_prev_[slot] = 0;
+  if (pl.fresh[slot]) {
+    has_prev_[slot] = 0;
+    drop_[slot] = 0.0f;  // nothing of the slot's previous agent carries over
+  }
 
   // Sample and blend the planned layers.
   PoseLayer layers[kMaxBlendLayers];
@@ -177,6 +180,11 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
     }
   }
   rot_change_[slot] = change;
+  // The toes as drawn, in every mode: foot locking starts from them (also after being off).
+  for (int side = 0; side < 2; ++side) {
+    locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
+        translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+  }
   std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   has_prev_[slot] = 1;
   if (make_palettes_) {
@@ -336,10 +344,6 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
   }
   if (!use_ik[0] && !use_ik[1]) {
     drop_[slot] = 0.0f;
-    for (int side = 0; side < 2; ++side) {
-      locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
-          translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
-    }
     return;
   }
   // Pelvis drop: a pinned foot the leg cannot reach pulls the whole body down (up to kMaxDrop)
@@ -413,10 +417,6 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
   }
   fk_from(slot, std::min(skeleton_.ankle(Side::kLeft), skeleton_.ankle(Side::kRight)), placed);
-  for (int side = 0; side < 2; ++side) {
-    locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
-        translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
-  }
 }
 
 }  // namespace gk

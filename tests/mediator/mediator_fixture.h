@@ -1,7 +1,9 @@
 #pragma once
 // Runs the mediator and pose synthesis over a scripted crowd and returns the METRICS.md report.
 
+#include <initializer_list>
 #include <memory>
+#include <string>
 
 #include "animation/procedural.h"
 #include "mediator/mediator.h"
@@ -21,6 +23,22 @@ inline const LocomotionLibrary& builtin_library() {
   return lib;
 }
 
+// The built-in set without the clips whose names contain any of `drop` (e.g. {"strafe",
+// "backward"} leaves forward clips only, like the mannequin and CMU sets).
+inline LocomotionLibrary builtin_library_without(std::initializer_list<const char*> drop) {
+  ClipSet set = make_builtin_clip_set();
+  std::erase_if(set.clips, [&](const Clip& c) {
+    for (const char* d : drop) {
+      if (c.name.find(d) != std::string::npos) return true;
+    }
+    return false;
+  });
+  std::vector<ClipSet> sets{std::move(set)};
+  Result<LocomotionLibrary> r = build_locomotion_library(sets);
+  if (!r.ok()) throw std::runtime_error(r.message());
+  return std::move(*r);
+}
+
 struct RunResult {
   MetricsReport report;
   uint64_t sanitised = 0;
@@ -38,7 +56,7 @@ inline RunResult run_scripted(const LocomotionLibrary& lib, std::vector<Script> 
   for (int f = 0; f < frames; ++f) {
     EXPECT_TRUE(crowd.step(kDt).ok());
     const AgentFrame frame = crowd.frame();
-    const Status s = mediator.plan(frame, kDt);
+    const Status s = mediator.plan(frame, kDt, crowd.feedback_policy());
     EXPECT_TRUE(s.ok()) << s.message();
     poses.run(mediator, kDt);
     metrics.record(frame, mediator, poses);

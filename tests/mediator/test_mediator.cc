@@ -90,42 +90,99 @@ TEST(Mediator, RootFollowsTheSimulator) {
 TEST(Mediator, FeedsBackTheSpeedItCanDeliver) {
   // 9 m/s is beyond anything the clips can do (3.6 x 1.35 x 1.2 = 5.83 m/s).
   std::vector<Script> s{straight({0, 0}, {0.0f, 9.0f})};
-  const auto r = run_scripted(builtin_library(), s, MediatorParams{}, 120);
+  const auto r = run_scripted(builtin_library(), s, MediatorParams{}, 120, /*honour=*/true);
   ASSERT_TRUE(r.report.feedback_speed_change.has_value());
   EXPECT_NEAR(*r.report.feedback_speed_change, 1.0 - 3.6 * 1.35 * 1.2 / 9.0, 0.01);
   EXPECT_EQ(r.feedback_frames, 120);
 }
 
-TEST(Mediator, FeedsBackAWalkingDirectionTheLegsCanTake) {
-  // Walking +z at 1.3 m/s, the simulator turns the velocity to +x in one frame (a jam's jitter).
-  // The legs turn at lower_turn_rate_deg_s, so the velocity fed back stays within
-  // turn_feedback_deg of where they walk, and reaches +x once they have turned.
-  const LocomotionLibrary& lib = builtin_library();
-  MediatorParams p;
+// A simulator with inertia that honours feedback: each frame its velocity moves from the one fed
+// back toward the desired one with time constant kTau, and it walks with the velocity fed back.
+struct TurningRun {
+  int feedback_frames = 0;   // frames whose velocity was fed back changed
+  int frames_to_turn = -1;   // until the velocity fed back is within 10 degrees of the desired one
+  float max_off_deg = 0.0f;  // largest angle between the velocity fed back and the lower body
+  glm::vec2 position{0.0f};
+};
+TurningRun run_turn(const LocomotionLibrary& lib, const MediatorParams& p, float turn_deg,
+                    float look_deg) {
+  constexpr float kDt = 1.0f / 60.0f, kTau = 0.1f, kSpeed = 1.3f;
   Mediator m(lib, p, 1);
-  const float dt = 1.0f / 60.0f;
   const uint32_t id = 5;
-  glm::vec2 pos(0.0f), vel(0.0f, 1.3f);
-  float theta = 0.0f;
-  int turned_back = 0;
-  float last_dir = 0.0f;
-  for (int f = 0; f < 120; ++f) {
-    if (f == 60) vel = glm::vec2(1.3f, 0.0f);
-    theta = std::atan2(vel.x, vel.y);
-    ASSERT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, dt).ok());
+  glm::vec2 pos(0.0f), vel(0.0f, kSpeed);
+  TurningRun out;
+  for (int f = 0; f < 180; ++f) {
+    const float want = f < 60 ? 0.0f : glm::radians(turn_deg);
+    const glm::vec2 desired = kSpeed * glm::vec2(std::sin(want), std::cos(want));
+    vel += (desired - vel) * (kDt / kTau);
+    const float theta = want + glm::radians(look_deg);
+    EXPECT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt,
+                       FeedbackPolicy::kHonoured)
+                    .ok());
     const FeedbackBuffers& fb = m.feedback();
-    const glm::vec2 out = fb.velocities[0];
-    const float dir = std::atan2(out.x, out.y);
-    const float walked = m.plans().travel_yaw[m.plans().slot_of_agent[0]];
-    EXPECT_LE(std::abs(wrap_pi(dir - walked)), glm::radians(p.turn_feedback_deg) + 1e-3f) << f;
-    EXPECT_NEAR(glm::length(out), 1.3f, 1e-3f) << f;  // the speed is kept
-    if (fb.has_feedback[0]) ++turned_back;
-    pos += out * dt;  // an honouring simulator moves with the velocity fed back, and asks again
-    last_dir = dir;
+    const float psi = m.plans().lower_yaw[m.plans().slot_of_agent[0]];
+    if (fb.has_feedback[0] && glm::length(fb.velocities[0] - vel) > 1e-4f) {
+      ++out.feedback_frames;  // the velocity was changed (theta may be fed back on its own)
+      EXPECT_NEAR(glm::length(fb.velocities[0]), glm::length(vel), 1e-3f) << f;  // speed kept
+      vel = fb.velocities[0];
+    }
+    const float off = std::abs(wrap_pi(std::atan2(vel.x, vel.y) - psi));
+    out.max_off_deg = std::max(out.max_off_deg, glm::degrees(off));
+    if (f >= 60 && out.frames_to_turn < 0 &&
+        std::abs(wrap_pi(std::atan2(vel.x, vel.y) - want)) < glm::radians(10.0f)) {
+      out.frames_to_turn = f - 60;
+    }
+    pos += vel * kDt;
   }
-  EXPECT_GE(turned_back, 3);  // a 90 degree turn at 300 deg/s takes 0.3 s
-  EXPECT_LE(turned_back, 40);
-  EXPECT_NEAR(last_dir, std::numbers::pi_v<float> / 2.0f, glm::radians(p.turn_feedback_deg));
+  out.position = pos;
+  return out;
+}
+
+TEST(Mediator, FeedsBackAWalkingDirectionTheLegsCanTake) {
+  // Forward clips only (like the mannequin and CMU sets): the legs walk where the lower body
+  // faces, which turns at lower_turn_rate_deg_s. A sharp turn of the simulator's velocity is
+  // held to within turn_feedback_deg of that facing, and the turn still completes at about the
+  // legs' rate (135 degrees at 300 deg/s: 27 frames).
+  const LocomotionLibrary lib = test::builtin_library_without({"strafe", "backward"});
+  ASSERT_FALSE(lib.has_direction_clips());
+  MediatorParams p;
+  const TurningRun r = run_turn(lib, p, 135.0f, 0.0f);
+  EXPECT_GE(r.feedback_frames, 5);
+  EXPECT_LE(r.max_off_deg, p.turn_feedback_deg + 0.1f);
+  ASSERT_GE(r.frames_to_turn, 0);
+  EXPECT_LE(r.frames_to_turn, 45);
+  // Without the feedback the simulator turns faster than the legs.
+  p.turn_feedback_deg = 180.0f;
+  const TurningRun off = run_turn(lib, p, 135.0f, 0.0f);
+  EXPECT_EQ(off.feedback_frames, 0);
+  EXPECT_GE(off.max_off_deg, 40.0f);
+}
+
+TEST(Mediator, TurnFeedbackLeavesLibrariesWithDirectionClipsAlone) {
+  // Forward and backward clips, walking straight while looking 100 degrees aside: the legs switch
+  // to the backward clips, and the simulator must not be pulled along with them.
+  const LocomotionLibrary lib = test::builtin_library_without({"strafe"});
+  ASSERT_TRUE(lib.has_direction_clips());
+  const TurningRun r = run_turn(lib, MediatorParams{}, 0.0f, 100.0f);
+  EXPECT_EQ(r.feedback_frames, 0);
+  EXPECT_NEAR(r.position.x, 0.0f, 0.01f);
+}
+
+TEST(Mediator, AsksNoFeedbackOfASourceThatIgnoresIt) {
+  // 9 m/s is beyond the clips: an honouring source is told the speed, a replay nothing.
+  const LocomotionLibrary& lib = builtin_library();
+  for (FeedbackPolicy policy : {FeedbackPolicy::kHonoured, FeedbackPolicy::kIgnored}) {
+    Mediator m(lib, MediatorParams{}, 1);
+    const uint32_t id = 1;
+    const glm::vec2 pos(0.0f), vel(0.0f, 9.0f);
+    const float theta = 0.0f;
+    ASSERT_TRUE(
+        m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, 1.0f / 60.0f, policy).ok());
+    EXPECT_EQ(m.feedback().has_feedback[0], policy == FeedbackPolicy::kHonoured ? 1 : 0);
+    if (policy == FeedbackPolicy::kIgnored) {
+      EXPECT_EQ(m.feedback().velocities[0], vel);
+    }
+  }
 }
 
 TEST(Mediator, SurvivesNaNAndAbsurdInput) {
