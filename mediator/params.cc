@@ -45,8 +45,9 @@ constexpr ParamInfo kInfos[] = {
     {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator",
      0.0f, 1.0f, K::kBool, nullptr, &P::feedback},
     {"turn_feedback_deg", "deg",
-     "feedback turns the simulator's velocity to within this of where the legs walk", 0.0f, 180.0f,
-     K::kFloat, &P::turn_feedback_deg},
+     "forward clips only: feedback turns the simulator's velocity to within this of where the "
+     "legs face (180 = off)",
+     0.0f, 180.0f, K::kFloat, &P::turn_feedback_deg},
     {"stride_variation", "x", "per-agent spread of stride length (crowd variety)", 0.0f, 0.2f,
      K::kFloat, &P::stride_variation},
 };

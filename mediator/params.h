@@ -42,7 +42,8 @@ struct MediatorParams {
   float idle_step_time_s = 0.35f;  // [s] [Limit: 0.1..1] duration of a re-planting step
   // 8. Feedback to the simulator.
   bool feedback = true;
-  float turn_feedback_deg = 10.0f;  // [deg] [Limit: 0..180] velocity direction the legs can't take
+  float turn_feedback_deg = 10.0f;  // [deg] [Limit: 0..180] forward-only libraries: velocity kept
+                                    // within this of the lower body's facing (180 = off)
   // Variety.
   float stride_variation = 0.05f;  // [ratio] [Limit: 0..0.2] per-agent clip speed spread
   uint64_t seed = 1;
