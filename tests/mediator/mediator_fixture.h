@@ -5,11 +5,13 @@
 #include <memory>
 #include <string>
 
+#include "animation/clip_library.h"
 #include "animation/procedural.h"
 #include "mediator/mediator.h"
 #include "mediator/metrics.h"
 #include "mediator/pose_synthesis.h"
 #include "tests/mediator/scripted_crowd.h"
+#include "tests/test_data.h"
 
 namespace gk::test {
 
@@ -37,6 +39,24 @@ inline LocomotionLibrary builtin_library_without(std::initializer_list<const cha
   Result<LocomotionLibrary> r = build_locomotion_library(sets);
   if (!r.ok()) throw std::runtime_error(r.message());
   return std::move(*r);
+}
+
+// One clip set per file of the shared data (paths relative to it), in order.
+inline Result<std::vector<ClipSet>> load_data_clip_sets(std::initializer_list<const char*> files) {
+  std::vector<ClipSet> sets;
+  for (const char* f : files) {
+    Result<ClipSet> set = load_clip_file(data_path(f));
+    if (!set.ok()) return set.status();
+    sets.push_back(std::move(*set));
+  }
+  return sets;
+}
+
+// The clip library of those files.
+inline Result<LocomotionLibrary> load_data_library(std::initializer_list<const char*> files) {
+  Result<std::vector<ClipSet>> sets = load_data_clip_sets(files);
+  if (!sets.ok()) return sets.status();
+  return build_locomotion_library(*sets);
 }
 
 struct RunResult {

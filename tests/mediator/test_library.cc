@@ -56,12 +56,10 @@ TEST(LocomotionLibrary, InPlaceClipsKeepOnlyTheSway) {
 
 TEST(LocomotionLibrary, TwoActorsOfTheCmuRetargetedOntoOne) {
   GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
-  std::vector<ClipSet> sets;
-  for (const char* f : {"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"}) {
-    auto set = load_clip_file(test::data_path(f));
-    ASSERT_TRUE(set.ok()) << set.message();
-    sets.push_back(std::move(*set));
-  }
+  auto loaded =
+      test::load_data_clip_sets({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  std::vector<ClipSet>& sets = *loaded;
   // Leg lengths of the two actors, to predict the run's speed on the walker's body.
   auto leg = [](const Skeleton& sk) {
     std::vector<glm::mat4> m(sk.num_joints());
@@ -87,10 +85,7 @@ TEST(LocomotionLibrary, TwoActorsOfTheCmuRetargetedOntoOne) {
 
 TEST(LocomotionLibrary, MannequinGlbKeepsLocomotionAndItsIdle) {
   GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
-  auto set = load_clip_file(test::data_path("clips/gltf/ual_mannequin_quaternius.glb"));
-  ASSERT_TRUE(set.ok()) << set.message();
-  std::vector<ClipSet> sets{std::move(*set)};
-  auto lib = build_locomotion_library(sets);
+  auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
   ASSERT_TRUE(lib.ok()) << lib.message();
   EXPECT_EQ(lib->clips[lib->idle].clip.name, "Idle_Loop");
   EXPECT_NE(find(*lib, "Walk_Loop"), nullptr);

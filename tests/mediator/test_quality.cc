@@ -95,13 +95,8 @@ TEST(Quality, GalleryUpperBodyFacesTheExhibits) {
 TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
   GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
   GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
-  std::vector<ClipSet> sets;
-  for (const char* f : {"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"}) {
-    auto set = load_clip_file(test::data_path(f));
-    ASSERT_TRUE(set.ok()) << set.message();
-    sets.push_back(std::move(*set));
-  }
-  auto lib = build_locomotion_library(sets);
+  auto lib =
+      test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
   ASSERT_TRUE(lib.ok()) << lib.message();
   auto a = scenario_crowd("bottleneck", true);
   auto b = scenario_crowd("bottleneck", true);
@@ -112,10 +107,7 @@ TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
 TEST(Quality, ReplayedPedestriansWithTheMannequinClips) {
   GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
   GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
-  auto set = load_clip_file(test::data_path("clips/gltf/ual_mannequin_quaternius.glb"));
-  ASSERT_TRUE(set.ok()) << set.message();
-  std::vector<ClipSet> sets{std::move(*set)};
-  auto lib = build_locomotion_library(sets);
+  auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
   ASSERT_TRUE(lib.ok()) << lib.message();
   auto a = load_trajectory_replay(test::data_path("trajectories/zara1/crowds_zara01.txt"));
   auto b = load_trajectory_replay(test::data_path("trajectories/zara1/crowds_zara01.txt"));
