@@ -151,6 +151,18 @@ std::string summary(const BenchReport& r) {
          " (outside limits " + num(m["playback_rate"]["outside_limits"], 4) + "); pops " +
          num(m["pop_count"], 0) + "; feedback speed change " + num(m["feedback_speed_change"], 3) +
          "\n";
+    const nlohmann::json& fl = m["feet_floor"];
+    s += "  v2 feet (clips' floor in brackets): support slide " + num(m["support_slide_cm_s"], 2) +
+         " cm/s [" + num(fl["support_slide_cm_s"], 2) + "], p95 " +
+         num(m["support_slide_p95_cm_s"], 2) + ", support skate " +
+         num(m["support_skate_ratio"], 4) + " [" + num(fl["support_skate_ratio"], 4) +
+         "], gmd skate " + num(m["gmd_skate_ratio"], 4) + " [" + num(fl["gmd_skate_ratio"], 4) +
+         "]\n";
+    s += "  float " + num(m["float_ratio"], 4) + " [" + num(fl["float_ratio"], 4) +
+         "], penetration p99/max " + num(m["penetration_cm"]["p99"], 2) + "/" +
+         num(m["penetration_cm"]["max"], 2) + " cm [" + num(fl["penetration_cm"]["max"], 2) +
+         "], limb pops " + num(m["limb_pop_rate"], 2) + " per agent-minute [" +
+         num(fl["limb_pop_rate"], 2) + "]\n";
   }
   return s;
 }
@@ -168,6 +180,37 @@ nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& 
     ++floor_n;
   }
   const bool slid = m.slide.num_samples > 0;
+  // METRICS.md v2, with the library's own clips (their floor) beside.
+  const Skeleton& sk = *library.skeleton;
+  json floor_m = json::object(), accel_ref = json::object();
+  for (int s = 0; s < 2; ++s) {
+    const Side side = static_cast<Side>(s);
+    floor_m[limb_joint_name(sk, LimbJoint::kToe, side)] = m.feet_reference.toe_floor_m[s];
+    floor_m[limb_joint_name(sk, LimbJoint::kAnkle, side)] = m.feet_reference.ankle_floor_m[s];
+    for (int j = 0; j < kNumLimbJoints; ++j) {
+      accel_ref[limb_joint_name(sk, static_cast<LimbJoint>(j), side)] =
+          m.feet_reference.accel_m_s2[j][s];
+    }
+  }
+  auto feet_json = [](const ViewerFeetStats& v) {
+    const bool sup = v.support_samples > 0, fr = v.agent_frames > 0;
+    return json{
+        {"support_slide_cm_s", sup ? json(v.support_slide_cm_s) : json(nullptr)},
+        {"support_slide_p95_cm_s", sup ? json(v.support_slide_p95_cm_s) : json(nullptr)},
+        {"support_skate_ratio", sup ? json(v.support_skate_ratio) : json(nullptr)},
+        {"float_ratio", v.float_samples ? json(v.float_ratio) : json(nullptr)},
+        {"penetration_cm",
+         {{"p99", fr ? json(v.penetration_p99_cm) : json(nullptr)},
+          {"max", fr ? json(v.penetration_max_cm) : json(nullptr)}}},
+        {"penetration_ratio", fr ? json(v.penetration_ratio) : json(nullptr)},
+        {"limb_pop_rate", fr ? json(v.limb_pop_rate) : json(nullptr)},
+        {"gmd_skate_ratio", v.gmd_frames ? json(v.gmd_skate_ratio) : json(nullptr)},
+        {"support_samples", v.support_samples},
+        {"limb_pops", v.limb_pops},
+    };
+  };
+  const ViewerFeetStats& f = m.feet;
+  const bool support = f.support_samples > 0, frames = f.agent_frames > 0;
   return {
       {"foot_slide_cm_s", slid ? json(m.slide.mean_cm_s) : json(nullptr)},
       {"foot_slide_p95_cm_s", slid ? json(m.slide.p95_cm_s) : json(nullptr)},
@@ -203,6 +246,20 @@ nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& 
         {"outside_limits", m.playback_outside_limits}}},
       {"pop_count", m.pop_count},
       {"max_root_jerk", m.max_root_jerk},
+      {"floor_m", floor_m},
+      {"limb_accel_reference_m_s2", accel_ref},
+      {"support_slide_cm_s", support ? json(f.support_slide_cm_s) : json(nullptr)},
+      {"support_slide_p95_cm_s", support ? json(f.support_slide_p95_cm_s) : json(nullptr)},
+      {"support_skate_ratio", support ? json(f.support_skate_ratio) : json(nullptr)},
+      {"float_ratio", f.float_samples ? json(f.float_ratio) : json(nullptr)},
+      {"penetration_cm",
+       {{"p99", frames ? json(f.penetration_p99_cm) : json(nullptr)},
+        {"max", frames ? json(f.penetration_max_cm) : json(nullptr)}}},
+      {"penetration_ratio", frames ? json(f.penetration_ratio) : json(nullptr)},
+      {"limb_pop_rate", frames ? json(f.limb_pop_rate) : json(nullptr)},
+      {"gmd_skate_ratio", f.gmd_frames ? json(f.gmd_skate_ratio) : json(nullptr)},
+      {"support_slide_samples", f.support_samples},
+      {"feet_floor", feet_json(m.feet_floor)},
   };
 }
 

@@ -228,7 +228,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--dump-joints", options->dump_joints,
                   "Write world joint positions per frame and agent to this CSV");
   cmd->add_option("--dump-joint-names", options->dump_joint_names,
-                  "Comma-separated joints to dump (default: left/right ankle and toe)");
+                  "Comma-separated joints to dump (default: left/right ankle and toe, knees, hip joints, hips)");
   cmd->callback([options] { run_bench(*options); });
 }
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The quality matrix of the mediator: every built-in scenario on both simulators and every
-# trajectory file in the shared data, with the built-in clips, the mannequin glTF clips and the two
-# CMU clips, in naive and apm modes, 60 Hz, 600 frames. Writes a Markdown table (stdout, and
+# trajectory file in the shared data, with the built-in clips, the mannequin glTF clips, the two
+# CMU clips and the CMU subject-16 set (clips/bvh/more), in naive and apm modes, 60 Hz, 600 frames,
+# with the METRICS.md v1 and v2 columns (v2 floors of the library's own clips in brackets). Writes a Markdown table (stdout, and
 # bench/quality.md unless QUALITY_OUT is set) and keeps every JSON report in $QUALITY_DIR.
 # Usage: bench/quality.sh [--frames F] [--agents N]   (needs jq and a built ./build/app/gaitkeeper)
 set -euo pipefail
@@ -27,6 +28,7 @@ declare -A clipsets=(
   [builtin]=""
   [mannequin]="--clips $data/clips/gltf/ual_mannequin_quaternius.glb"
   [cmu]="--clips $data/clips/bvh/cmu_07_01_walk.bvh $data/clips/bvh/cmu_09_11_run.bvh"
+  [more]="--clips $data/clips/bvh/more"
 )
 runs=()
 for sc in corridor crossing circle bottleneck plaza gallery; do
@@ -39,14 +41,14 @@ for f in "$data"/trajectories/*/*.txt; do
 done
 
 {
-  echo "| scenario | sim | clips | mode | slide cm/s (floor) | skate | torsion max | facing p95 | heading p95 | root mean/max cm | rate outside | pops | naive/apm slide |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| scenario | sim | clips | mode | slide cm/s (floor) | skate | support slide cm/s [floor] | support skate | gmd skate [floor] | float | penetration p99/max cm | limb pops /agent-min [floor] | torsion max | facing p95 | heading p95 | root mean/max cm | rate outside | pops | naive/apm support slide |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$out.tmp"
-total=$(( ${#runs[@]} * 3 * 2 ))
+total=$(( ${#runs[@]} * 4 * 2 ))
 k=0
 for run in "${runs[@]}"; do
   IFS='|' read -r name args sim <<<"$run"
-  for cs in builtin mannequin cmu; do
+  for cs in builtin mannequin cmu more; do
     declare -A slide=()
     for mode in naive apm; do
       k=$((k + 1))
@@ -54,14 +56,14 @@ for run in "${runs[@]}"; do
       echo "[$k/$total] $name $sim $cs $mode" >&2
       # shellcheck disable=SC2086
       if ! $gk bench $args ${clipsets[$cs]} --mode $mode --frames "$frames" --json "$json" >/dev/null 2>"$json.err"; then
-        echo "| $name | $sim | $cs | $mode | failed: $(tail -1 "$json.err") |||||||||" >> "$out.tmp"
+        echo "| $name | $sim | $cs | $mode | failed: $(tail -1 "$json.err") |||||||||||||||" >> "$out.tmp"
         continue
       fi
-      slide[$mode]=$(jq '.metrics.foot_slide_cm_s // 0' "$json")
+      slide[$mode]=$(jq '.metrics.support_slide_cm_s // 0' "$json")
       jq -r --arg n "$name" --arg s "$sim" --arg c "$cs" --arg mo "$mode" '
         def f(x; d): if x == null then "n/a" else (x * pow(10; d) | round / pow(10; d) | tostring) end;
         .metrics as $m |
-        "| \($n) | \($s) | \($c) | \($mo) | \(f($m.foot_slide_cm_s; 2)) (\(f($m.foot_slide_floor_cm_s; 2))) | \(f($m.skate_ratio; 4)) | \(f($m.torsion_deg.max; 1)) | \(f($m.facing_error_deg.p95; 1)) | \(f($m.heading_error_deg.p95; 1)) | \(f($m.root_error_cm.mean; 2))/\(f($m.root_error_cm.max; 2)) | \(f($m.playback_rate.outside_limits; 4)) | \($m.pop_count) |"' \
+        "| \($n) | \($s) | \($c) | \($mo) | \(f($m.foot_slide_cm_s; 2)) (\(f($m.foot_slide_floor_cm_s; 2))) | \(f($m.skate_ratio; 4)) | \(f($m.support_slide_cm_s; 2)) [\(f($m.feet_floor.support_slide_cm_s; 2))] | \(f($m.support_skate_ratio; 4)) | \(f($m.gmd_skate_ratio; 4)) [\(f($m.feet_floor.gmd_skate_ratio; 4))] | \(f($m.float_ratio; 4)) | \(f($m.penetration_cm.p99; 2))/\(f($m.penetration_cm.max; 2)) | \(f($m.limb_pop_rate; 2)) [\(f($m.feet_floor.limb_pop_rate; 2))] | \(f($m.torsion_deg.max; 1)) | \(f($m.facing_error_deg.p95; 1)) | \(f($m.heading_error_deg.p95; 1)) | \(f($m.root_error_cm.mean; 2))/\(f($m.root_error_cm.max; 2)) | \(f($m.playback_rate.outside_limits; 4)) | \($m.pop_count) |"' \
         "$json" | tr -d '\n' >> "$out.tmp"
       if [[ $mode == apm ]]; then
         awk -v n="${slide[naive]:-0}" -v a="${slide[apm]}" 'BEGIN { if (a > 0) printf " %.1fx |\n", n / a; else print " n/a |" }' >> "$out.tmp"

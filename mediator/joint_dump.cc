@@ -12,14 +12,20 @@ Result<JointDumpWriter> JointDumpWriter::open(const std::string& path, const Ske
   std::vector<int> joints;
   std::vector<std::string> used;
   if (names.empty()) {
-    for (Side s : {Side::kLeft, Side::kRight}) {
-      for (int j : {skeleton.ankle(s), skeleton.toe(s)}) {
-        if (j >= 0) {
-          joints.push_back(j);
-          used.push_back(skeleton.names[j]);
-        }
+    // METRICS.md v2: per foot the ankle and toe, then both knees, both hip joints and the hips.
+    auto add = [&](int j) {
+      if (j >= 0) {
+        joints.push_back(j);
+        used.push_back(skeleton.names[j]);
       }
+    };
+    for (Side s : {Side::kLeft, Side::kRight}) {
+      add(skeleton.ankle(s));
+      add(skeleton.toe(s));
     }
+    for (Side s : {Side::kLeft, Side::kRight}) add(skeleton.knee(s));
+    for (Side s : {Side::kLeft, Side::kRight}) add(skeleton.hip(s));
+    add(skeleton.role(JointRole::kHips));
   } else {
     for (const std::string& n : names) {
       const int j = skeleton.find(n);
@@ -58,8 +64,11 @@ Status JointDumpWriter::write_frame(int frame, double time_s, const AgentFrame& 
     const auto world = poses.world(slot);
     for (size_t k = 0; k < joints_.size(); ++k) {
       const glm::vec3 p = translation_of(world[joints_[k]]);
-      std::fprintf(file_, "%d,%.9g,%u,%s,%.9g,%.9g,%.9g\n", frame, time_s, agents.ids[i],
-                   names_[k].c_str(), p.x, p.y, p.z);
+      // Each float as the exact decimal of its double value (17 digits): a reader that
+      // parses doubles gets the very numbers the metrics used, so ties between feet break alike.
+      std::fprintf(file_, "%d,%.9g,%u,%s,%.17g,%.17g,%.17g\n", frame, time_s, agents.ids[i],
+                   names_[k].c_str(), static_cast<double>(p.x), static_cast<double>(p.y),
+                   static_cast<double>(p.z));
     }
   }
   if (std::ferror(file_)) return Status::Error(path_ + ": write failed (disk full?)");

@@ -1,8 +1,8 @@
 #pragma once
 // The per-frame joint dump of METRICS.md: final world-space positions of named joints of every
-// agent on every frame, exactly as rendered, as CSV `frame,time_s,agent,joint,x,y,z`. Floats are
-// written with 9 significant digits, enough to reproduce each value exactly, so a metric recomputed
-// from the file equals the one in the JSON report.
+// agent on every frame, exactly as rendered, as CSV `frame,time_s,agent,joint,x,y,z`. Positions
+// are written with 17 significant digits, the exact value of each float read as a double, so a
+// metric recomputed from the file equals the one in the JSON report (feet at equal heights too).
 
 #include <cstdio>
 #include <string>
@@ -16,7 +16,8 @@ namespace gk {
 
 class JointDumpWriter {
  public:
-  // names: joint names of the library skeleton; empty = left/right ankle and toe.
+  // names: joint names of the library skeleton; empty = left/right ankle and toe, both knees,
+  // both hip joints and the hips (METRICS.md v2).
   static Result<JointDumpWriter> open(const std::string& path, const Skeleton& skeleton,
                                       const std::vector<std::string>& names);
   JointDumpWriter(JointDumpWriter&& other) noexcept;

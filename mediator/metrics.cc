@@ -34,7 +34,11 @@ Summary summarize(std::vector<float>& v) {
 
 MetricsRecorder::MetricsRecorder(const LocomotionLibrary& library, float frame_time_s,
                                  size_t capacity, size_t frames_hint)
-    : library_(library), dt_(frame_time_s), frames_hint_(frames_hint) {
+    : library_(library),
+      dt_(frame_time_s),
+      frames_hint_(frames_hint),
+      feet_reference_(make_feet_reference(library, frame_time_s)),
+      feet_floor_(library_feet_floor(library, feet_reference_, frame_time_s)) {
   const size_t n = capacity * frames_hint;
   torsion_.reserve(n);
   facing_.reserve(n);
@@ -64,6 +68,7 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
       for (int s = 0; s < 2; ++s) {
         t.toe[s].reserve(frames_hint_);
         t.ankle[s].reserve(frames_hint_);
+        t.knee[s].reserve(frames_hint_);
       }
       t.root.reserve(frames_hint_);
     }
@@ -72,6 +77,7 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
     for (int s = 0; s < 2; ++s) {
       t.toe[s].push_back(translation_of(w[sk.toe(static_cast<Side>(s))]));
       t.ankle[s].push_back(translation_of(w[sk.ankle(static_cast<Side>(s))]));
+      t.knee[s].push_back(translation_of(w[sk.knee(static_cast<Side>(s))]));
     }
     const glm::vec3 pelvis = translation_of(w[hips]);
     const glm::vec2 root(pelvis.x, pelvis.z);
@@ -114,9 +120,18 @@ MetricsReport MetricsRecorder::finish() const {
   MetricsReport r;
   r.agent_frames = agent_frames_;
   SlideAccumulator slide;
+  ViewerFeetAccumulator feet(feet_reference_);
   double max_jerk = 0.0;
   auto add = [&](const Track& t) {
     for (int s = 0; s < 2; ++s) slide.add_track(t.toe[s], t.ankle[s], dt_);
+    LimbTrack limbs;
+    for (int s = 0; s < 2; ++s) {
+      limbs.joint[static_cast<int>(LimbJoint::kToe)][s] = t.toe[s];
+      limbs.joint[static_cast<int>(LimbJoint::kAnkle)][s] = t.ankle[s];
+      limbs.joint[static_cast<int>(LimbJoint::kKnee)][s] = t.knee[s];
+    }
+    limbs.root = t.root;
+    feet.add_track(limbs, dt_);
     const auto& p = t.root;
     for (size_t k = 3; k < p.size(); ++k) {
       const glm::vec2 j = (p[k] - 3.0f * p[k - 1] + 3.0f * p[k - 2] - p[k - 3]) / (dt_ * dt_ * dt_);
@@ -126,6 +141,9 @@ MetricsReport MetricsRecorder::finish() const {
   for (const auto& [id, t] : tracks_) add(t);
   for (const Track& t : finished_) add(t);
   r.slide = slide.finish();
+  r.feet = feet.finish();
+  r.feet_floor = feet_floor_;
+  r.feet_reference = feet_reference_;
   r.max_root_jerk = max_jerk;
   auto copy_summary = [](std::vector<float> v) { return summarize(v); };
   r.torsion_deg = copy_summary(torsion_);

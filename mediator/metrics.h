@@ -14,6 +14,7 @@
 #include "crowd/crowd_source.h"
 #include "mediator/mediator.h"
 #include "mediator/pose_synthesis.h"
+#include "mediator/viewer_metrics.h"
 
 namespace gk {
 
@@ -33,6 +34,11 @@ struct MetricsReport {
   int64_t pop_count = 0;
   double max_root_jerk = 0.0;  // [m/s^3]
   int64_t agent_frames = 0;
+  // METRICS.md v2: the feet against the floor the clips were authored on, and the same figures of
+  // the library's own clips (its floor).
+  FeetReference feet_reference;
+  ViewerFeetStats feet;
+  ViewerFeetStats feet_floor;
 };
 
 // Summary of samples: mean, nearest-rank p95, min, max.
@@ -49,13 +55,15 @@ class MetricsRecorder {
 
  private:
   struct Track {
-    std::vector<glm::vec3> toe[2], ankle[2];
+    std::vector<glm::vec3> toe[2], ankle[2], knee[2];
     std::vector<glm::vec2> root;
     int last_frame = -1;
   };
   const LocomotionLibrary& library_;
   float dt_;
   size_t frames_hint_;
+  FeetReference feet_reference_;
+  ViewerFeetStats feet_floor_;
   int frame_ = 0;
   std::unordered_map<uint32_t, Track> tracks_;
   std::vector<Track> finished_;

@@ -1,0 +1,257 @@
+#include "mediator/viewer_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "animation/pose_jobs.h"
+
+namespace gk {
+namespace {
+
+// Nearest-rank percentile q in [0, 1] of v (reorders v); 0 for no samples.
+float percentile(std::vector<float>& v, double q) {
+  if (v.empty()) return 0.0f;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(std::ceil(q * v.size())) - 1);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+int joint_index(const Skeleton& sk, LimbJoint j, Side s) {
+  switch (j) {
+    case LimbJoint::kToe:
+      return sk.toe(s);
+    case LimbJoint::kAnkle:
+      return sk.ankle(s);
+    case LimbJoint::kKnee:
+      return sk.knee(s);
+  }
+  return -1;
+}
+
+// One locomotion clip played once with its own root motion (the in-place clip plus its travel)
+// at a step of dt_s: world positions of the limb joints and the root.
+struct PlayedClip {
+  std::vector<glm::vec3> joint[kNumLimbJoints][2];
+  std::vector<glm::vec2> root;
+  LimbTrack track() const {
+    LimbTrack t;
+    for (int j = 0; j < kNumLimbJoints; ++j) {
+      for (int s = 0; s < 2; ++s) t.joint[j][s] = joint[j][s];
+    }
+    t.root = root;
+    return t;
+  }
+};
+
+PlayedClip play_with_root_motion(const LocomotionClip& lc, const Skeleton& sk, float dt_s) {
+  PlayedClip out;
+  const size_t J = sk.num_joints();
+  std::vector<glm::quat> rot(J);
+  std::vector<glm::vec3> trans(J);
+  std::vector<glm::mat4> model(J);
+  const float duration = lc.clip.duration_s();
+  const glm::vec3 travel =
+      lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
+  const int hips = sk.role(JointRole::kHips);
+  // A loop is played for one period (its end is its start); a take from its first to last frame.
+  const int steps =
+      static_cast<int>(std::floor(duration / dt_s + (lc.clip.loops ? -1e-4f : 1e-4f)));
+  for (int k = 0; k <= steps; ++k) {
+    const float t = k * dt_s;
+    SampleClipJob{&lc.clip, t, rot, trans}.run();
+    glm::mat4 root(1.0f);
+    root[3] = glm::vec4(travel * t, 1.0f);
+    LocalToModelJob{&sk, rot, trans, root, model}.run();
+    for (int j = 0; j < kNumLimbJoints; ++j) {
+      for (int s = 0; s < 2; ++s) {
+        out.joint[j][s].push_back(translation_of(
+            model[joint_index(sk, static_cast<LimbJoint>(j), static_cast<Side>(s))]));
+      }
+    }
+    const glm::vec3 p = translation_of(model[hips]);
+    out.root.emplace_back(p.x, p.z);
+  }
+  return out;
+}
+
+bool locomotion(const LocomotionClip& c) { return c.gait; }
+
+}  // namespace
+
+std::string limb_joint_name(const Skeleton& sk, LimbJoint j, Side s) {
+  const int i = joint_index(sk, j, s);
+  return i >= 0 ? sk.names[i] : std::string();
+}
+
+FeetReference make_feet_reference(const LocomotionLibrary& library, float dt_s) {
+  FeetReference ref;
+  const Skeleton& sk = *library.skeleton;
+  std::vector<glm::mat4> model(sk.num_joints());
+  std::vector<float> toe_h[2], ankle_h[2];
+  std::vector<float> accel[kNumLimbJoints][2];
+  for (const LocomotionClip& lc : library.clips) {
+    if (!locomotion(lc)) continue;
+    const Clip& c = lc.clip;
+    std::vector<uint8_t> contact(c.num_frames);
+    for (int s = 0; s < 2; ++s) {
+      std::fill(contact.begin(), contact.end(), 0);
+      for (const TimeInterval& iv : lc.analysis.contacts[s]) {
+        const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
+        const int b = static_cast<int>(std::lround(iv.end_s * c.fps));
+        for (int f = std::max(a, 0); f <= std::min(b, c.num_frames - 1); ++f) contact[f] = 1;
+      }
+      for (int f = 0; f < c.num_frames; ++f) {
+        if (!contact[f]) continue;
+        LocalToModelJob{&sk,
+                        {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
+                        {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
+                        glm::mat4(1.0f),
+                        model}
+            .run();
+        toe_h[s].push_back(model[sk.toe(static_cast<Side>(s))][3].y);
+        ankle_h[s].push_back(model[sk.ankle(static_cast<Side>(s))][3].y);
+      }
+    }
+    const PlayedClip played = play_with_root_motion(lc, sk, dt_s);
+    for (int j = 0; j < kNumLimbJoints; ++j) {
+      for (int s = 0; s < 2; ++s) {
+        const auto& p = played.joint[j][s];
+        for (size_t k = 1; k + 1 < p.size(); ++k) {
+          accel[j][s].push_back(glm::length(p[k + 1] - 2.0f * p[k] + p[k - 1]) / (dt_s * dt_s));
+        }
+      }
+    }
+  }
+  for (int s = 0; s < 2; ++s) {
+    // Without analysed contacts the lowest heights stand in (a clip still has a lowest foot).
+    ref.toe_floor_m[s] = toe_h[s].empty() ? library.toe_floor_m[s] : percentile(toe_h[s], 0.5);
+    ref.ankle_floor_m[s] =
+        ankle_h[s].empty() ? library.ankle_floor_m[s] : percentile(ankle_h[s], 0.5);
+    for (int j = 0; j < kNumLimbJoints; ++j) ref.accel_m_s2[j][s] = percentile(accel[j][s], 0.999);
+  }
+  return ref;
+}
+
+void ViewerFeetAccumulator::add_track(const LimbTrack& t, float dt) {
+  const size_t n = t.root.size();
+  if (n == 0) return;
+  // Double precision throughout, so that a check recomputed from the joint dump (whose numbers
+  // reproduce these floats exactly) breaks ties between the feet the same way.
+  const double floor_toe[2] = {ref_.toe_floor_m[0], ref_.toe_floor_m[1]};
+  const double floor_ankle[2] = {ref_.ankle_floor_m[0], ref_.ankle_floor_m[1]};
+  const auto& toe = t.joint[static_cast<int>(LimbJoint::kToe)];
+  const auto& ankle = t.joint[static_cast<int>(LimbJoint::kAnkle)];
+  auto rel = [&](int s, size_t f) { return static_cast<double>(toe[s][f].y) - floor_toe[s]; };
+  auto support = [&](size_t f) { return rel(1, f) < rel(0, f) ? 1 : 0; };
+  auto near = [&](int s, size_t f) { return rel(s, f) <= kNearFloorM; };
+  auto horizontal = [](const glm::vec3& a, const glm::vec3& b) {
+    return std::hypot(static_cast<double>(a.x) - b.x, static_cast<double>(a.z) - b.z);
+  };
+  agent_frames_ += static_cast<int64_t>(n);
+  seconds_ += n * static_cast<double>(dt);
+  for (size_t f = 0; f < n; ++f) {
+    for (int s = 0; s < 2; ++s) {
+      const double depth =
+          std::max({0.0, floor_toe[s] - toe[s][f].y, floor_ankle[s] - ankle[s][f].y});
+      depth_cm_.push_back(static_cast<float>(100.0 * depth));
+      if (depth > kPenetrationCountM) ++deep_;
+    }
+    if (f == 0) continue;
+    const int sup = support(f);
+    if (sup == support(f - 1) && near(sup, f) && near(sup, f - 1)) {
+      const double v = 100.0 * horizontal(toe[sup][f], toe[sup][f - 1]) / dt;
+      support_cm_s_.push_back(static_cast<float>(v));
+      if (v > kSkateCmS) ++support_skates_;
+    }
+    const double root_speed = std::hypot(static_cast<double>(t.root[f].x) - t.root[f - 1].x,
+                                         static_cast<double>(t.root[f].y) - t.root[f - 1].y) /
+                              dt;
+    if (root_speed >= kFloatMinSpeed && root_speed <= kFloatMaxSpeed) {
+      ++float_samples_;
+      if (!near(0, f) && !near(1, f)) ++float_frames_;
+    }
+    if (f + 1 < n) {
+      bool pop = false;
+      for (int j = 0; j < kNumLimbJoints && !pop; ++j) {
+        for (int s = 0; s < 2 && !pop; ++s) {
+          const auto& p = t.joint[j][s];
+          const glm::dvec3 d2 =
+              glm::dvec3(p[f + 1]) - 2.0 * glm::dvec3(p[f]) + glm::dvec3(p[f - 1]);
+          const double a = glm::length(d2) / (static_cast<double>(dt) * dt);
+          pop = a > 2.0f * ref_.accel_m_s2[j][s];
+        }
+      }
+      if (pop) ++pops_;
+    }
+  }
+  // The literature's ratio at 20 fps: toes linearly resampled from the run's frames.
+  const double span_s = (n - 1) * static_cast<double>(dt);
+  const int m = static_cast<int>(std::floor(span_s * kGmdRateHz + 1e-6)) + 1;
+  auto toe_at = [&](int s, int k) {
+    const double x = k / static_cast<double>(kGmdRateHz) / dt;
+    const size_t i = std::min(static_cast<size_t>(x + 1e-9), n - 1);
+    const size_t i1 = std::min(i + 1, n - 1);
+    const double u = std::clamp(x - static_cast<double>(i), 0.0, 1.0);
+    return glm::dvec3(toe[s][i]) + (glm::dvec3(toe[s][i1]) - glm::dvec3(toe[s][i])) * u;
+  };
+  auto horizontal_d = [](const glm::dvec3& a, const glm::dvec3& b) {
+    return std::hypot(a.x - b.x, a.z - b.z);
+  };
+  glm::dvec3 prev[2] = {toe_at(0, 0), toe_at(1, 0)};
+  for (int k = 1; k < m; ++k) {
+    bool skates = false;
+    for (int s = 0; s < 2; ++s) {
+      const glm::dvec3 cur = toe_at(s, k);
+      const bool contact =
+          cur.y - floor_toe[s] <= kNearFloorM && prev[s].y - floor_toe[s] <= kNearFloorM;
+      if (contact && horizontal_d(cur, prev[s]) * kGmdRateHz > kGmdSkateM_S) skates = true;
+      prev[s] = cur;
+    }
+    ++gmd_frames_;
+    if (skates) ++gmd_skates_;
+  }
+}
+
+ViewerFeetStats ViewerFeetAccumulator::finish() const {
+  ViewerFeetStats r;
+  r.agent_frames = agent_frames_;
+  r.support_samples = static_cast<int64_t>(support_cm_s_.size());
+  if (!support_cm_s_.empty()) {
+    double sum = 0.0;
+    for (float v : support_cm_s_) sum += v;
+    r.support_slide_cm_s = sum / support_cm_s_.size();
+    std::vector<float> copy = support_cm_s_;
+    r.support_slide_p95_cm_s = percentile(copy, 0.95);
+    r.support_skate_ratio = static_cast<double>(support_skates_) / support_cm_s_.size();
+  }
+  r.float_samples = float_samples_;
+  if (float_samples_) r.float_ratio = static_cast<double>(float_frames_) / float_samples_;
+  r.penetration_samples = static_cast<int64_t>(depth_cm_.size());
+  if (!depth_cm_.empty()) {
+    std::vector<float> copy = depth_cm_;
+    r.penetration_p99_cm = percentile(copy, 0.99);
+    r.penetration_max_cm = *std::max_element(depth_cm_.begin(), depth_cm_.end());
+    r.penetration_ratio = static_cast<double>(deep_) / depth_cm_.size();
+  }
+  r.limb_pops = pops_;
+  if (seconds_ > 0.0) r.limb_pop_rate = pops_ / (seconds_ / 60.0);
+  r.gmd_frames = gmd_frames_;
+  if (gmd_frames_) r.gmd_skate_ratio = static_cast<double>(gmd_skates_) / gmd_frames_;
+  return r;
+}
+
+ViewerFeetStats library_feet_floor(const LocomotionLibrary& library, const FeetReference& ref,
+                                   float dt_s) {
+  ViewerFeetAccumulator acc(ref);
+  for (const LocomotionClip& lc : library.clips) {
+    if (!locomotion(lc)) continue;
+    const PlayedClip played = play_with_root_motion(lc, *library.skeleton, dt_s);
+    acc.add_track(played.track(), dt_s);
+  }
+  return acc.finish();
+}
+
+}  // namespace gk
