@@ -169,6 +169,111 @@ std::vector<float> gait_phase(const ClipAnalysis& a, float period_s) {
   return phase;
 }
 
+// Frames on either side for velocities: about 1/60 s, so 120 fps capture jitter is averaged the
+// same as 30 fps.
+int velocity_half_window(float fps) {
+  return std::max(1, static_cast<int>(std::lround(fps / 60.0f)));
+}
+
+// Horizontal velocity of track p at frame f relative to the clip's hips (in_place) or the world,
+// by a central difference over +-k frames (wrapping a loop, whose root jumps back by per_loop).
+glm::vec3 track_velocity(const std::vector<glm::vec3>& p, const Tracks& tr, int f, int k,
+                         const Clip& clip, bool relative_to_root) {
+  const int n = static_cast<int>(p.size());
+  const glm::vec3 per_loop = (tr.root[n - 1] - tr.root[0]) * (static_cast<float>(n) / (n - 1));
+  auto at = [&](int i) {
+    glm::vec3 shift(0.0f);
+    if (clip.loops) {
+      const int wraps = i < 0 ? -((-i + n - 1) / n) : i / n;
+      i -= wraps * n;
+      shift = per_loop * static_cast<float>(wraps);
+    } else {
+      i = std::clamp(i, 0, n - 1);
+    }
+    glm::vec3 q = p[i] + shift;
+    if (relative_to_root) q -= tr.root[i] + shift;
+    return q;
+  };
+  const int lo = clip.loops ? f - k : std::max(0, f - k);
+  const int hi = clip.loops ? f + k : std::min(n - 1, f + k);
+  if (hi == lo) return glm::vec3(0.0f);
+  glm::vec3 v = (at(hi) - at(lo)) * (clip.fps / static_cast<float>(hi - lo));
+  v.y = 0.0f;
+  return v;
+}
+
+float percentile_of(std::vector<float> v, float q) {
+  if (v.empty()) return 0.0f;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<float>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// Travel velocity of an in-place clip: its stance foot slides backward under the hips at it. The
+// stance foot is the lower one on most frames of any gait, so the median over frames of the lower
+// foot's velocity (relative to the hips) is minus the travel velocity.
+glm::vec3 in_place_travel(const Tracks& tr, const Clip& clip) {
+  const int n = static_cast<int>(tr.root.size());
+  const int k = velocity_half_window(clip.fps);
+  std::vector<float> vx, vz;
+  // "Lower" against each foot's own lowest heights (a rig's two toe joints need not be level).
+  float low[2];
+  for (int s = 0; s < 2; ++s) {
+    std::vector<float> h(n);
+    for (int f = 0; f < n; ++f) h[f] = tr.toe[s][f].y;
+    low[s] = percentile_of(h, 0.05f);
+  }
+  for (int f = 0; f < n; ++f) {
+    const int s = tr.toe[1][f].y - low[1] < tr.toe[0][f].y - low[0] ? 1 : 0;
+    const glm::vec3 v = track_velocity(tr.toe[s], tr, f, k, clip, true);
+    vx.push_back(v.x);
+    vz.push_back(v.z);
+  }
+  auto median = [](std::vector<float>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  glm::vec3 travel(-median(vx), 0.0f, -median(vz));
+  if (glm::length(travel) < kInPlaceSpeed) travel = glm::vec3(0.0f);
+  return travel;
+}
+
+// One foot's contact frames: its ball or its heel (ankle) nearly still over the ground and low.
+// "Still" is relative to the clip's own travel speed (a stance foot moves a small fraction of it;
+// a swing foot about twice it); "low" is relative to the joint's own lowest heights over the fitted
+// ground (a gate well below the swing's height, never the judge alone).
+void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalysis& a,
+                     const glm::vec3& travel_vel, const ContactThresholds& th,
+                     std::vector<uint8_t>* out) {
+  const int n = static_cast<int>(tr.root.size());
+  const int k = velocity_half_window(clip.fps);
+  const float still =
+      std::max(th.min_still_speed_m_s, th.still_fraction_of_travel * glm::length(travel_vel));
+  out->assign(n, 0);
+  const std::vector<glm::vec3>* joints[2] = {&tr.toe[s], &tr.ankle[s]};
+  std::vector<uint8_t> down[2];
+  for (int j = 0; j < 2; ++j) {
+    const std::vector<glm::vec3>& p = *joints[j];
+    std::vector<float> h(n), speed(n);
+    std::vector<uint8_t> backward(n, 0);
+    const float travel = glm::length(travel_vel);
+    for (int f = 0; f < n; ++f) {
+      h[f] = p[f].y - (a.ground_y0_m + a.ground_slope_m_s * (f / clip.fps));
+      glm::vec3 v = track_velocity(p, tr, f, k, clip, a.in_place);
+      // In place, a stance foot is carried backward under the hips and a swing foot forward: the
+      // sign holds even for keyframed clips whose stance foot is not ground-consistent.
+      if (a.in_place && travel > 0.0f) backward[f] = glm::dot(v, travel_vel) < 0.0f;
+      if (a.in_place) v += travel_vel;
+      speed[f] = glm::length(v);
+    }
+    const float low = percentile_of(h, 0.05f), high = percentile_of(h, 0.95f);
+    const float gate = low + std::max(th.min_height_gate_m, th.height_gate_fraction * (high - low));
+    down[j].assign(n, 0);
+    for (int f = 0; f < n; ++f) down[j][f] = (speed[f] < still || backward[f]) && h[f] <= gate;
+  }
+  for (int f = 0; f < n; ++f) (*out)[f] = down[0][f] || down[1][f];
+}
+
 }  // namespace
 
 ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThresholds& th) {
@@ -197,50 +302,16 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
   glm::vec3 root_vel = (tr.root[n - 1] - tr.root[0]) / span_s;
   root_vel.y = 0.0f;
   a.in_place = glm::length(root_vel) < kInPlaceSpeed;
+  if (a.in_place) root_vel = glm::vec3(0.0f);
 
-  // Contacts by height (METRICS.md thresholds), then velocity relative to the ground.
-  glm::vec3 travel_vel = root_vel;
-  std::vector<uint8_t> contact[2];
+  // Contacts, velocity first: a planted foot's ball (or heel) stops over the ground; a height
+  // gate relative to the foot's own low heights keeps a slow swing foot out.
   fit_ground(tr, clip.fps, &a.ground_y0_m, &a.ground_slope_m_s);
   if (clip.loops) a.ground_slope_m_s = 0.0f;  // a loop returns to where it started
+  const glm::vec3 travel_vel = a.in_place ? in_place_travel(tr, clip) : root_vel;
+  std::vector<uint8_t> contact[2];
   for (int s = 0; s < 2; ++s) {
-    std::vector<glm::vec3> toe = tr.toe[s], ankle = tr.ankle[s];
-    for (int f = 0; f < n; ++f) {
-      const float g = a.ground_slope_m_s * (f / clip.fps);
-      toe[f].y -= g;
-      ankle[f].y -= g;
-    }
-    contact[s].resize(n);
-    measure_contacts(toe, ankle, contact[s]);
-  }
-  if (a.in_place) {
-    // The stance foot of an in-place clip slides backward under the hips at the travel speed.
-    glm::vec3 sum(0.0f);
-    int count = 0;
-    for (int s = 0; s < 2; ++s) {
-      for (int f = 1; f < n; ++f) {
-        if (!contact[s][f] || !contact[s][f - 1]) continue;
-        glm::vec3 d = (tr.toe[s][f] - tr.root[f]) - (tr.toe[s][f - 1] - tr.root[f - 1]);
-        d.y = 0.0f;
-        sum += d * clip.fps;
-        ++count;
-      }
-    }
-    travel_vel = count > 0 ? -sum / static_cast<float>(count) : glm::vec3(0.0f);
-    if (glm::length(travel_vel) < kInPlaceSpeed) travel_vel = glm::vec3(0.0f);
-  }
-  // Drop "contacts" where the toe moves fast over the ground (swing foot passing low).
-  for (int s = 0; s < 2; ++s) {
-    for (int f = 0; f < n; ++f) {
-      const int g = f + 1 < n ? f + 1 : (clip.loops ? 0 : f - 1);
-      if (g < 0 || g == f) continue;
-      const float dir = g > f ? 1.0f : -1.0f;
-      glm::vec3 d = (tr.toe[s][g] - tr.toe[s][f]) * dir * clip.fps;
-      if (clip.loops && g == 0) d = glm::vec3(0.0f);  // skip the wrap's root jump
-      if (a.in_place) d += travel_vel - (tr.root[g] - tr.root[f]) * dir * clip.fps;
-      d.y = 0.0f;
-      if (glm::length(d) > th.max_speed_m_s) contact[s][f] = 0;
-    }
+    detect_contacts(tr, s, clip, a, travel_vel, th, &contact[s]);
     filter_runs(contact[s],
                 std::max(2, static_cast<int>(std::lround(th.min_duration_s * clip.fps))),
                 clip.loops);
@@ -251,14 +322,21 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
   a.direction_rad =
       a.native_speed_m_s > 0.0f ? wrap_angle(heading_of(travel_vel) - heading_of(facing)) : 0.0f;
 
-  // Gait cycle: the loop for looping clips; otherwise the first full stride of the left foot.
+  // Gait cycle: the loop for looping clips; otherwise the first full stride of a foot, from one
+  // contact start to its next (a contact cut by the take's first frame starts no stride).
   float period = a.duration_s;
-  if (!clip.loops && a.contacts[0].size() >= 2) {
-    a.cycle = {a.contacts[0][0].start_s, a.contacts[0][1].start_s};
-    period = a.cycle.end_s - a.cycle.start_s;
-  } else if (!clip.loops && a.contacts[1].size() >= 2) {
-    a.cycle = {a.contacts[1][0].start_s, a.contacts[1][1].start_s};
-    period = a.cycle.end_s - a.cycle.start_s;
+  if (!clip.loops) {
+    for (int s : {0, 1}) {
+      std::vector<float> starts;
+      for (const TimeInterval& c : a.contacts[s]) {
+        if (c.start_s > 0.5f / clip.fps) starts.push_back(c.start_s);
+      }
+      if (starts.size() >= 2) {
+        a.cycle = {starts[0], starts[1]};
+        period = starts[1] - starts[0];
+        break;
+      }
+    }
   }
   if (clip.loops && a.contacts[0].size() >= 2) period = a.duration_s / a.contacts[0].size();
   a.phase = gait_phase(a, period);

@@ -15,11 +15,16 @@ struct TimeInterval {
   float end_s = 0.0f;
 };
 
+// Contact detection, velocity first: a foot is down while its ball or heel is nearly still over the
+// ground and low. Speeds are relative to the clip's own travel speed so that a walk and a sprint
+// are judged alike; heights relative to the joint's own range over the fitted ground.
 struct ContactThresholds {
-  float height_above_min_m = 0.025f;  // toe height above its lowest point (METRICS.md)
-  float ankle_above_min_m = 0.05f;    // ankle height above its lowest point (METRICS.md)
-  float max_speed_m_s = 0.6f;         // horizontal toe speed relative to the ground
-  float min_duration_s = 0.04f;       // shorter contacts and gaps are capture jitter: dropped
+  float still_fraction_of_travel = 0.3f;  // [ratio] "still": slower than this share of travel
+  float min_still_speed_m_s = 0.2f;       // [m/s] and never a stricter limit than this (capture
+                                          // jitter; standing clips)
+  float height_gate_fraction = 0.3f;      // [ratio] low: within this share of the joint's range
+  float min_height_gate_m = 0.02f;        // [m] of its lowest heights, and at least this
+  float min_duration_s = 0.04f;           // [s] shorter contacts and gaps are jitter: dropped
 };
 
 struct SlideStats {

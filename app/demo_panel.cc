@@ -198,8 +198,9 @@ void DemoApp::panel_agent() {
   }
   const FootLocks& locks = session_->poses().foot_locks();
   static constexpr const char* kLock[] = {"free", "locked", "releasing", "stepping"};
-  ImGui::Text("left foot %s, right foot %s", kLock[std::min<int>(locks.state[slot * 2], 3)],
-              kLock[std::min<int>(locks.state[slot * 2 + 1], 3)]);
+  ImGui::Text("left foot %s, right foot %s",
+              kLock[std::min<int>(static_cast<int>(locks.lock[slot * 2].state), 3)],
+              kLock[std::min<int>(static_cast<int>(locks.lock[slot * 2 + 1].state), 3)]);
 }
 
 void DemoApp::panel_params() {

@@ -117,8 +117,8 @@ void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane
     if (t.planted) {
       for (int s = 0; s < 2; ++s) {
         const size_t k = slot * 2 + s;
-        if (static_cast<FootLockState>(locks.state[k]) == FootLockState::kLocked) {
-          cross(r, locks.target[k] * glm::vec3(1, 0, 1) + glm::vec3(0, 0.01f, 0), 0.12f,
+        if (locks.lock[k].state == FootLockState::kLocked) {
+          cross(r, locks.lock[k].target * glm::vec3(1, 0, 1) + glm::vec3(0, 0.01f, 0), 0.12f,
                 {1.0f, 1.0f, 1.0f});
         }
       }

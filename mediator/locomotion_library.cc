@@ -143,12 +143,6 @@ bool build_phase_table(LocomotionClip* lc) {
   return lc->cycle_s > 0.0f;
 }
 
-constexpr float kPlantToe = 0.035f;   // [m] METRICS.md contact (2.5 cm) with a margin: toe this low
-constexpr float kPlantAnkle = 0.06f;  // [m] and the ankle within this of its lowest (5 cm + margin)
-constexpr float kPlantSpeed = 1.5f;   // [m/s] a foot moving faster over the ground is swinging
-constexpr float kHoldToe = 0.035f;    // [m] a lock is kept until the toe rises past this
-constexpr float kHoldAnkle = 0.07f;   // [m] or the ankle past this (heel-off pivots on the ball)
-
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
   const Clip& c = lc->clip;
   const int n = c.num_frames;
@@ -175,22 +169,55 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     }
     lc->toe_floor_m[s] = min_t;
     lc->ankle_floor_m[s] = min_a;
-    std::vector<uint8_t> analysed(n, 0);
+    // A lock may start where clip analysis has the foot in contact.
     for (const TimeInterval& iv : lc->analysis.contacts[s]) {
       const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
       const int b = static_cast<int>(std::lround(iv.end_s * c.fps));
-      for (int f = a; f <= b; ++f) analysed[((f % n) + n) % n] = 1;
+      for (int f = a; f <= b; ++f) lc->plant[s][((f % n) + n) % n] = 1;
     }
+    // It is kept while the ball of the foot still bears weight: no higher above the ground, and
+    // no faster over it, than it ever is in this clip's own contacts (the heel may rise: the foot
+    // pivots on the ball at heel-off).
+    std::vector<float> speed(n);
     for (int f = 0; f < n; ++f) {
       const int g = f + 1 < n ? f + 1 : (c.loops ? 0 : f - 1);
       glm::vec3 vel = (toe[s][g] - toe[s][f]) * (g > f ? c.fps : -c.fps) + travel;
       if (g == 0) vel = travel;  // across a loop's wrap: no reliable difference
-      const float speed = std::hypot(vel.x, vel.z);
-      const float ht = toe[s][f].y - min_t, ha = ankle[s][f].y - min_a;
-      lc->toe_height_m[s][f] = ht;
-      lc->plant[s][f] =
-          analysed[f] || (ht <= kPlantToe && ha <= kPlantAnkle && speed < kPlantSpeed);
-      lc->hold[s][f] = lc->plant[s][f] || (ht <= kHoldToe && ha <= kHoldAnkle);
+      speed[f] = std::hypot(vel.x, vel.z);
+      lc->toe_height_m[s][f] = toe[s][f].y - min_t;
+    }
+    std::vector<float> contact_h, contact_v;
+    for (int f = 0; f < n; ++f) {
+      if (!lc->plant[s][f]) continue;
+      contact_h.push_back(lc->toe_height_m[s][f]);
+      contact_v.push_back(speed[f]);
+    }
+    if (contact_h.empty()) continue;
+    // The 90th percentile, not the maximum: one jittery capture frame must not hold a swing.
+    auto p90 = [](std::vector<float>& v) {
+      const size_t k = (v.size() * 9) / 10;
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+      return v[std::min(k, v.size() - 1)];
+    };
+    const float max_h = p90(contact_h), max_v = p90(contact_v);
+    // Swing progress between the end of one contact and the start of the next (wrapping a loop).
+    lc->swing_progress[s].assign(n, 0.0f);
+    for (int f = 0; f < n; ++f) {
+      if (lc->plant[s][f]) continue;
+      int back = 0, ahead = 0;
+      while (back < n &&
+             !lc->plant[s][c.loops ? ((f - back - 1) % n + n) % n : std::max(f - back - 1, 0)] &&
+             (c.loops || f - back - 1 >= 0)) {
+        ++back;
+      }
+      while (ahead < n && (c.loops || f + ahead + 1 < n) &&
+             !lc->plant[s][c.loops ? (f + ahead + 1) % n : std::min(f + ahead + 1, n - 1)]) {
+        ++ahead;
+      }
+      lc->swing_progress[s][f] = (back + 0.5f) / static_cast<float>(back + ahead + 1);
+    }
+    for (int f = 0; f < n; ++f) {
+      lc->hold[s][f] = lc->plant[s][f] || (lc->toe_height_m[s][f] <= max_h && speed[f] <= max_v);
     }
   }
 }
@@ -212,6 +239,68 @@ float max_rotation_step(const Clip& c, int num_joints) {
     std::swap(r0, r1);
   }
   return best;
+}
+
+// Heights [m] of each foot's toe and ankle on the frames clip analysis marks as contact (every
+// frame for a clip without contacts of that foot, e.g. a standing clip).
+struct ContactHeights {
+  std::vector<float> toe[2], ankle[2];
+};
+
+void add_contact_heights(const LocomotionClip& lc, const Skeleton& sk, ContactHeights* out) {
+  const Clip& c = lc.clip;
+  std::vector<glm::mat4> model(sk.num_joints());
+  std::vector<uint8_t> contact[2];
+  for (int s = 0; s < 2; ++s) {
+    contact[s].assign(c.num_frames, lc.analysis.contacts[s].empty() ? 1 : 0);
+    for (const TimeInterval& iv : lc.analysis.contacts[s]) {
+      const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
+      const int b = static_cast<int>(std::lround(iv.end_s * c.fps));
+      for (int f = a; f <= b; ++f)
+        contact[s][((f % c.num_frames) + c.num_frames) % c.num_frames] = 1;
+    }
+  }
+  for (int f = 0; f < c.num_frames; ++f) {
+    if (!contact[0][f] && !contact[1][f]) continue;
+    frame_model(c, sk, f, model);
+    for (int s = 0; s < 2; ++s) {
+      if (!contact[s][f]) continue;
+      out->toe[s].push_back(model[sk.toe(static_cast<Side>(s))][3].y);
+      out->ankle[s].push_back(model[sk.ankle(static_cast<Side>(s))][3].y);
+    }
+  }
+}
+
+float median(std::vector<float> v) {
+  if (v.empty()) return 0.0f;
+  const size_t k = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+float percentile(std::vector<float> v, float q) {
+  if (v.empty()) return 0.0f;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<float>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// Where a clip puts a flat foot's toe: a low percentile of its toe heights over its contact frames
+// (both feet); the rest of a contact rolls onto the heel or the ball, higher.
+constexpr float kFlatPercentile = 0.1f;
+float flat_toe_height(const LocomotionClip& lc, const Skeleton& sk) {
+  ContactHeights h;
+  add_contact_heights(lc, sk, &h);
+  std::vector<float> both = h.toe[0];
+  both.insert(both.end(), h.toe[1].begin(), h.toe[1].end());
+  return percentile(std::move(both), kFlatPercentile);
+}
+
+// Moves a clip up or down by dy [m] (the root joint's translation), keeping everything else.
+void raise_clip(LocomotionClip* lc, float dy) {
+  Clip& c = lc->clip;
+  for (int f = 0; f < c.num_frames; ++f)
+    c.translations[static_cast<size_t>(f) * c.num_joints].y += dy;
 }
 
 // A standing clip taken from the frame of a gait clip where both feet are planted closest
@@ -404,6 +493,67 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         synthesise_idle(lib.clips[lib.groups[lib.forward_group].clips.front()], sk));
   }
   lib.idle = static_cast<int>(lib.clips.size()) - 1;
+  // One floor for every clip: captures (and actors) stand at different heights, so each clip is
+  // raised or lowered until its flat feet stand where the clips' flat feet stand on the median.
+  {
+    std::vector<float> planted(lib.clips.size());
+    std::vector<float> gait_planted;
+    for (size_t i = 0; i < lib.clips.size(); ++i) {
+      planted[i] = flat_toe_height(lib.clips[i], sk);
+      if (lib.clips[i].gait) gait_planted.push_back(planted[i]);
+    }
+    const float common = median(gait_planted);
+    for (size_t i = 0; i < lib.clips.size(); ++i) {
+      LocomotionClip& c = lib.clips[i];
+      if (std::abs(common - planted[i]) < 1e-6f) continue;
+      raise_clip(&c, common - planted[i]);
+      if (c.gait) {
+        fill_contacts_and_heights(&c, sk);
+      } else {
+        for (int s = 0; s < 2; ++s) {
+          c.toe_floor_m[s] += common - planted[i];
+          c.ankle_floor_m[s] += common - planted[i];
+        }
+      }
+    }
+    // The floor of METRICS.md v2: where planted feet are, over the locomotion clips.
+    ContactHeights h;
+    for (const LocomotionClip& c : lib.clips) {
+      if (c.gait) add_contact_heights(c, sk, &h);
+    }
+    for (int s = 0; s < 2; ++s) {
+      lib.planted_toe_m[s] = median(h.toe[s]);
+      lib.planted_ankle_m[s] = median(h.ankle[s]);
+    }
+    // The METRICS.md floor is the median height of planted toes, which roll onto heel and ball
+    // above a flat foot: the feet are drawn this much higher so a flat foot stands on that floor.
+    lib.ground_lift_m =
+        std::max(0.0f, 0.5f * (lib.planted_toe_m[0] + lib.planted_toe_m[1]) - common);
+    // Swing height: the peak toe height of every swing (between two contacts) of the slowest
+    // forward clip.
+    const LocomotionClip& slow = lib.clips[lib.groups[lib.forward_group].clips.front()];
+    std::vector<float> peaks;
+    std::vector<glm::mat4> model(sk.num_joints());
+    for (int s = 0; s < 2; ++s) {
+      const auto& iv = slow.analysis.contacts[s];
+      const int nf = slow.clip.num_frames;
+      const size_t swings = slow.clip.loops ? iv.size() : (iv.empty() ? 0 : iv.size() - 1);
+      for (size_t k = 0; k < swings; ++k) {
+        const bool wraps = k + 1 == iv.size();
+        const int a = static_cast<int>(std::lround(iv[k].end_s * slow.clip.fps));
+        const int b = static_cast<int>(std::lround(iv[wraps ? 0 : k + 1].start_s * slow.clip.fps)) +
+                      (wraps ? nf : 0);
+        float peak = -1e9f;
+        for (int g = a; g <= b; ++g) {
+          const int f = slow.clip.loops ? ((g % nf) + nf) % nf : std::clamp(g, 0, nf - 1);
+          frame_model(slow.clip, sk, f, model);
+          peak = std::max(peak, model[sk.toe(static_cast<Side>(s))][3].y - lib.planted_toe_m[s]);
+        }
+        if (peak > 0.0f) peaks.push_back(peak);
+      }
+    }
+    if (!peaks.empty()) lib.swing_height_m = median(peaks);
+  }
   for (int s = 0; s < 2; ++s) {
     lib.toe_floor_m[s] = 1e9f;
     lib.ankle_floor_m[s] = 1e9f;

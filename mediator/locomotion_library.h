@@ -33,7 +33,10 @@ struct LocomotionClip {
   // where an existing lock is kept (the foot has not clearly lifted yet).
   std::vector<uint8_t> plant[2];
   std::vector<uint8_t> hold[2];
-  std::vector<float> toe_height_m[2];      // toe height above its lowest point
+  std::vector<float> toe_height_m[2];  // toe height above its lowest point
+  // How far through its swing each foot is, 0 where it leaves the ground to 1 where it lands
+  // (0 while planted).
+  std::vector<float> swing_progress[2];
   float toe_floor_m[2] = {0.0f, 0.0f};     // lowest toe height in the clip
   float ankle_floor_m[2] = {0.0f, 0.0f};   // lowest ankle height in the clip
   float time_at_phase(float phase) const;  // phase in [0, 1)
@@ -58,6 +61,18 @@ struct LocomotionLibrary {
   // planted feet are locked at this height.
   float toe_floor_m[2] = {0.0f, 0.0f};
   float ankle_floor_m[2] = {0.0f, 0.0f};  // likewise for the ankle joints
+  // The floor the clips were authored on (METRICS.md v2): median height of each toe and ankle over
+  // the frames clip analysis marks as contact, over the locomotion clips [m]. Every clip is moved
+  // up or down at load so that its planted toes stand on it. Pose synthesis never draws a foot
+  // below it.
+  float planted_toe_m[2] = {0.0f, 0.0f};
+  float planted_ankle_m[2] = {0.0f, 0.0f};
+  // How much higher than authored the feet are drawn so that a flat foot stands on planted_toe_m
+  // (the median of planted toes lies above a flat foot) [m].
+  float ground_lift_m = 0.0f;
+  // How high the slowest forward clip lifts a toe above planted_toe_m in swing (median of its
+  // swings) [m]: the height of a re-planting step.
+  float swing_height_m = 0.05f;
   // Largest per-frame change of any joint's local rotation over all source clips, resampled to
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;

@@ -69,6 +69,8 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   for (int s = 0; s < 2; ++s) {
     plans_.plant[s].assign(capacity, 1.0f);
     plans_.hold[s].assign(capacity, 1.0f);
+    plans_.gait_toe_y[s].assign(capacity, 0.0f);
+    plans_.swing_progress[s].assign(capacity, 0.0f);
   }
   plans_.phase.assign(capacity, 0.0f);
   plans_.blend_progress.assign(capacity, 1.0f);
@@ -377,18 +379,26 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   // Foot flags are voted by the gait clips alone once they carry a quarter of the blend: a standing
   // clip's "both feet down" would otherwise keep a stepping foot locked while it swings.
   float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
+  float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f};
   const bool gait_votes = gait_w >= 0.25f;
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     const LocomotionClip& clip = lib.clips[lc[k]];
     lt[k] = clip.gait ? clip.time_at_phase(phase_[slot])
                       : std::fmod(idle_time_[slot], std::max(clip.clip.duration_s(), 1e-3f));
-    if (lw[k] <= 0.0f || (gait_votes && !clip.gait)) continue;
-    vote_w += lw[k];
+    if (lw[k] <= 0.0f) continue;
     const int nf = clip.clip.num_frames;
     int f = static_cast<int>(std::lround(lt[k] * clip.clip.fps));
     f = clip.clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
     for (int s = 0; s < 2; ++s) {
+      if (clip.gait && !clip.toe_height_m[s].empty()) {
+        toe_gait[s] += lw[k] * (clip.toe_height_m[s][f] + clip.toe_floor_m[s]);
+      }
+    }
+    if (gait_votes && !clip.gait) continue;
+    vote_w += lw[k];
+    for (int s = 0; s < 2; ++s) {
       plant[s] += lw[k] * clip.plant[s][f];
+      if (!clip.swing_progress[s].empty()) swing[s] += lw[k] * clip.swing_progress[s][f];
       hold[s] += lw[k] * clip.hold[s][f];
     }
   }
@@ -443,6 +453,8 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   for (int s = 0; s < 2; ++s) {
     pl.plant[s][slot] = plant[s];
     pl.hold[s][slot] = hold[s];
+    pl.swing_progress[s][slot] = swing[s] / std::max(vote_w, 1e-6f);
+    pl.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : -1e9f;
   }
   pl.phase[slot] = phase_[slot];
   pl.blend_progress[slot] = fade_[slot];

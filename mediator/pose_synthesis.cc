@@ -26,33 +26,33 @@ glm::mat4 root_placement(const glm::vec2& xz, float yaw) {
 
 glm::quat rotation_of(const glm::mat4& m) { return glm::normalize(glm::quat_cast(glm::mat3(m))); }
 
-// Highest lift [m] of a released foot on its way back to the clip's foot.
-constexpr float kReleaseLiftMax = 0.05f;
-// A foot plants when its toe is within kPlantToe and its ankle within kPlantAnkle of the ground
-// (METRICS.md counts 2.5 cm and 5 cm as contact) and it moves slower than kPlantSpeed over it.
-constexpr float kPlantToe = 0.03f;
-constexpr float kPlantAnkle = 0.06f;
-constexpr float kPlantSpeed = 0.5f;  // [m/s]
-// A planted foot is held until its toe or ankle clearly lifts (heel-off pivots on the ball).
-constexpr float kHoldToe = 0.045f;
-constexpr float kHoldAnkle = 0.09f;
-// A foot that is not pinned and moves faster than kLiftSpeed low over the ground is lifted to
-// kClearance so it swings instead of dragging; fully from kClearSpeed on. METRICS.md counts a toe
-// within 2.5 cm of its lowest height as in contact, and 30 cm/s as skating.
-constexpr float kClearance = 0.045f;
-constexpr float kLiftSpeed = 0.2f;     // [m/s]
-constexpr float kClearSpeed = 0.3f;    // [m/s]
-constexpr float kMaxLiftSpeed = 1.5f;  // [m/s] fastest change of that lift
-constexpr float kMaxStepSpeed = 1.5f;  // [m/s] a released foot travels back no faster on average
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
-// kMaxDrop, and comes back up at kDropRecovery.
+// kMaxDrop, on a critically damped spring of halflife kDropHalflife (no vertical snap).
 constexpr float kDropReach = 0.99f;
 constexpr float kMaxDrop = 0.04f;       // [m]
-constexpr float kDropRecovery = 0.25f;  // [m/s]
+constexpr float kDropHalflife = 0.05f;  // [s]
 
-float smoothstep01(float x) {
-  x = std::clamp(x, 0.0f, 1.0f);
-  return x * x * (3.0f - 2.0f * x);
+// The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
+// about the ball, never past kMaxHeelOff (bisection; the distance grows monotonically less as the
+// heel rises toward the hip).
+constexpr float kMaxHeelOff =
+    1.0f;  // [rad] about 57 deg, a stance foot's plantarflexion at toe-off
+
+constexpr float kHeelHalflife = 0.05f;  // [s] a raised heel settles back this fast
+
+// Returns the pitch [rad].
+float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                     float limit) {
+  const glm::vec3 d = ankle - toe;
+  const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
+  auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
+  if (dist(kMaxHeelOff) > limit) return kMaxHeelOff;
+  float lo = 0.0f, hi = kMaxHeelOff;
+  for (int i = 0; i < 12; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (dist(mid) > limit ? lo : hi) = mid;
+  }
+  return hi;
 }
 
 }  // namespace
@@ -92,14 +92,12 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   upper_heading_.assign(capacity, 0.0f);
   has_prev_.assign(capacity, 0);
   drop_.assign(capacity, 0.0f);
-  locks_.state.assign(capacity * 2, static_cast<uint8_t>(FootLockState::kFree));
-  locks_.target.assign(capacity * 2, glm::vec3(0.0f));
-  locks_.from.assign(capacity * 2, glm::vec3(0.0f));
-  locks_.weight.assign(capacity * 2, 0.0f);
-  locks_.timer.assign(capacity * 2, 0.0f);
+  drop_rate_.assign(capacity, 0.0f);
+  locks_.lock.assign(capacity * 2, FootLock());
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
-  locks_.lift.assign(capacity * 2, 0.0f);
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
+  locks_.heel_pitch.assign(capacity * 2, 0.0f);
+  locks_.heel_pitch_rate.assign(capacity * 2, 0.0f);
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J] {
     Scratch s;
@@ -141,6 +139,7 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   if (pl.fresh[slot]) {
     has_prev_[slot] = 0;
     drop_[slot] = 0.0f;  // nothing of the slot's previous agent carries over
+    drop_rate_[slot] = 0.0f;
   }
 
   // Sample and blend the planned layers.
@@ -159,9 +158,10 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   std::span<glm::vec3> out_t(local_trans_.data() + base, J);
   BlendPosesJob{{layers, static_cast<size_t>(num_layers)}, out_r, out_t}.run();
 
-  const glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
-  fk_from(slot, 0, root);
   const bool apm = P.mode == MediatorMode::kApm;
+  glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
+  if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
+  fk_from(slot, 0, root);
   if (apm) twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   if (apm && P.foot_locking) lock_feet(m, slot, root, dt);
 
@@ -184,6 +184,13 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   for (int side = 0; side < 2; ++side) {
     locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
         translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+  }
+  if (!(apm && P.foot_locking)) {
+    for (int side = 0; side < 2; ++side) {
+      const size_t k = static_cast<size_t>(slot) * 2 + side;
+      locks_.lock[k] = FootLock();
+      locks_.anim_toe[k] = locks_.drawn_toe[k];
+    }
   }
   std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   has_prev_[slot] = 1;
@@ -221,173 +228,134 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
   const AnimationPlans& pl = m.plans();
   const MediatorParams& P = m.params();
   const size_t base = static_cast<size_t>(slot) * num_joints_;
-  glm::quat ankle_world_rot[2];
-  glm::vec3 toe_offset[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
-  bool use_ik[2] = {false, false}, pinned[2] = {false, false};
+  const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
+                          library_.swing_height_m};
+  glm::vec3 goal[2], anim_toe[2], anim_vel[2];
+  bool pinned[2] = {false, false};
   for (int side = 0; side < 2; ++side) {
-    const Side sd = static_cast<Side>(side);
-    const int ankle = skeleton_.ankle(sd), toe = skeleton_.toe(sd);
     const size_t k = static_cast<size_t>(slot) * 2 + side;
-    const glm::vec3 anim_toe = translation_of(world_[base + toe]);
-    const glm::vec3 anim_ankle = translation_of(world_[base + ankle]);
-    // Contact from the animated foot itself (after blending, placing and twisting), not from the
-    // clips' labels: a blend of a standing and a walking clip has feet of its own.
-    // Heights as drawn: the body is still lowered by last frame's pelvis drop.
-    const float toe_h = anim_toe.y - drop_[slot] - library_.toe_floor_m[side];
-    const float ankle_h = anim_ankle.y - drop_[slot] - library_.ankle_floor_m[side];
-    const glm::vec3 prev = locks_.anim_toe[k];
-    locks_.anim_toe[k] = anim_toe;
-    const float ground_speed =
-        pl.fresh[slot] ? 0.0f : std::hypot(anim_toe.x - prev.x, anim_toe.z - prev.z) / dt;
-    const bool planted = toe_h <= kPlantToe && ankle_h <= kPlantAnkle && ground_speed < kPlantSpeed;
-    const bool held = toe_h <= kHoldToe && ankle_h <= kHoldAnkle;
-    auto& state = reinterpret_cast<FootLockState&>(locks_.state[k]);
-    float& weight = locks_.weight[k];
-    glm::vec3& target = locks_.target[k];
-    if (pl.fresh[slot]) {
-      state = FootLockState::kFree;
-      weight = 0.0f;
-      locks_.lift[k] = 0.0f;
-      locks_.drawn_toe[k] = anim_toe;
-    }
-    const glm::vec3 drawn_before = locks_.drawn_toe[k];
-    switch (state) {
-      case FootLockState::kFree:
-        if (planted) {
-          // Pinned where it was drawn last frame: the foot stops on the frame it plants instead
-          // of taking one more step of the clip's (still slowing) foot.
-          state = FootLockState::kLocked;
-          target = glm::vec3(drawn_before.x, anim_toe.y, drawn_before.z);
-          weight = 1.0f;
-        }
-        break;
-      case FootLockState::kLocked: {
-        if (!held) {
-          state = FootLockState::kReleasing;
-          locks_.from[k] = target;
-          locks_.timer[k] = 0.0f;
-          break;
-        }
-        // The pinned toe follows the clip's toe down (a heel strike rolls onto the ball), never up.
-        target.y = std::min(target.y, anim_toe.y);
-        // Standing: a foot left behind by a turn or a drift is re-planted with a short step,
-        // one foot at a time.
-        const glm::vec3 d = target - anim_toe;
-        const float drift = std::hypot(d.x, d.z);
-        const size_t other = static_cast<size_t>(slot) * 2 + (1 - side);
-        if (drift > P.idle_step_distance_m) {
-          if (!pl.standing[slot]) {  // walking slowly with feet that hardly lift: step anyway
-            state = FootLockState::kReleasing;
-            locks_.from[k] = target;
-            locks_.timer[k] = 0.0f;
-          } else if (locks_.state[other] == static_cast<uint8_t>(FootLockState::kLocked)) {
-            state = FootLockState::kStepping;
-            locks_.from[k] = target;
-            locks_.timer[k] = 0.0f;
-          }
-        }
-        break;
-      }
-      case FootLockState::kReleasing: {
-        // The foot is carried from where it was pinned to where the clip has it: lifted first,
-        // then moved, so a released foot steps instead of sliding over the ground.
-        // timer holds the progress 0..1; a long way back takes longer (at most kMaxStepSpeed).
-        const glm::vec3 from = locks_.from[k];
-        const float gap = std::hypot(anim_toe.x - from.x, anim_toe.z - from.z);
-        locks_.timer[k] += dt / std::max(P.lock_release_s, gap / kMaxStepSpeed);
-        const float u = std::min(1.0f, locks_.timer[k]);
-        const float lift = std::min(kReleaseLiftMax, 5.0f * gap) *
-                           std::sqrt(std::max(0.0f, std::sin(3.14159265f * u)));
-        target = glm::mix(from, anim_toe, smoothstep01(u)) + glm::vec3(0.0f, lift, 0.0f);
-        weight = 1.0f;
-        if (u >= 1.0f) {
-          state = FootLockState::kFree;
-          weight = 0.0f;
-        }
-        break;
-      }
-      case FootLockState::kStepping: {
-        locks_.timer[k] += dt;
-        const float u = locks_.timer[k] / P.idle_step_time_s;
-        const glm::vec3 from = locks_.from[k];
-        target = glm::mix(from, anim_toe, smoothstep01(u));
-        target.y = glm::mix(from.y, anim_toe.y, smoothstep01(u)) +
-                   0.05f * std::sin(3.14159265f * std::min(u, 1.0f));
-        weight = 1.0f;
-        if (u >= 1.0f) {
-          state = FootLockState::kLocked;
-          target = anim_toe;
-        }
-        break;
-      }
-    }
-    // A free or released foot skimming the ground fast is lifted clear (continuous in height and
-    // speed). The speed is that of the foot as it will be drawn, from where it was drawn.
-    float lift = 0.0f;
-    if ((state == FootLockState::kFree || state == FootLockState::kReleasing) &&
-        ankle_h <= kHoldAnkle) {
-      const glm::vec3 goal = glm::mix(anim_toe, target, weight);
-      const float speed =
-          pl.fresh[slot] ? 0.0f : std::hypot(goal.x - drawn_before.x, goal.z - drawn_before.z) / dt;
-      const float fast = smoothstep01((speed - kLiftSpeed) / (kClearSpeed - kLiftSpeed));
-      const float h = goal.y - drop_[slot] - library_.toe_floor_m[side];
-      lift = std::max(0.0f, kClearance - h) * fast;
-    }
-    // Rate-limited so the knee never snaps (a pop) when the foot speeds up through the band.
-    const float max_change = kMaxLiftSpeed * dt;
-    lift = std::clamp(lift, locks_.lift[k] - max_change, locks_.lift[k] + max_change);
-    locks_.lift[k] = lift;
-    use_ik[side] = weight > 0.0f || lift > 0.0f;
-    // Where the toe must go, relative to the animated foot (the ankle moves by the same offset).
-    toe_offset[side] = glm::mix(anim_toe, target, weight) + glm::vec3(0.0f, lift, 0.0f) - anim_toe;
-    pinned[side] = weight > 0.0f;
-  }
-  if (!use_ik[0] && !use_ik[1]) {
-    drop_[slot] = 0.0f;
-    return;
+    // The clip's toe, no lower than the gait clips alone have it (a blend with a standing pose
+    // swings lower).
+    anim_toe[side] = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+    anim_toe[side].y = std::max(anim_toe[side].y, pl.gait_toe_y[side][slot] + root[3].y);
+    FootLockInput in;
+    in.anim_toe = anim_toe[side];
+    in.anim_toe_prev = locks_.anim_toe[k];
+    in.drawn_toe_prev = locks_.drawn_toe[k];
+    in.fresh = pl.fresh[slot] != 0;
+    in.plant = pl.plant[side][slot] >= 0.5f;
+    in.hold = pl.hold[side][slot] >= 0.5f;
+    in.swing_progress = pl.swing_progress[side][slot];
+    in.standing = pl.standing[slot] != 0;
+    in.other_locked =
+        locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
+    in.floor_toe_m = library_.planted_toe_m[side];
+    goal[side] = step_foot_lock(locks_.lock[k], in, lp, dt);
+    anim_vel[side] = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
+
+    locks_.anim_toe[k] = anim_toe[side];
+    const FootLockState st = locks_.lock[k].state;
+    pinned[side] = st == FootLockState::kLocked || st == FootLockState::kStepping;
   }
   // Pelvis drop: a pinned foot the leg cannot reach pulls the whole body down (up to kMaxDrop)
-  // rather than sliding; the drop eases back at kDropRecovery.
+  // rather than sliding; the body moves on a critically damped spring.
   float needed = 0.0f;
   for (int side = 0; side < 2; ++side) {
     if (!pinned[side]) continue;
     const Side sd = static_cast<Side>(side);
-    const glm::vec3 goal = translation_of(world_[base + skeleton_.ankle(sd)]) + toe_offset[side];
+    const glm::vec3 ankle_goal = translation_of(world_[base + skeleton_.ankle(sd)]) + goal[side] -
+                                 translation_of(world_[base + skeleton_.toe(sd)]);
     const glm::vec3 hip_p = translation_of(world_[base + skeleton_.hip(sd)]);
     const float reach = kDropReach * library_.leg_length_m[side];
-    const float dx = std::hypot(goal.x - hip_p.x, goal.z - hip_p.z), dy = hip_p.y - goal.y;
+    const float dx = std::hypot(ankle_goal.x - hip_p.x, ankle_goal.z - hip_p.z);
+    const float dy = hip_p.y - ankle_goal.y;
     if (dx < reach && dy > 0.0f) needed = std::max(needed, dy - std::sqrt(reach * reach - dx * dx));
   }
-  float drop = std::max(needed, drop_[slot] - kDropRecovery * dt);
-  drop = std::clamp(drop, 0.0f, kMaxDrop);
-  drop_[slot] = drop;
+  if (pl.fresh[slot]) drop_[slot] = drop_rate_[slot] = 0.0f;
+  critical_spring(drop_[slot], drop_rate_[slot], std::min(needed, kMaxDrop), kDropHalflife, dt);
+  drop_[slot] = std::clamp(drop_[slot], 0.0f, kMaxDrop);
+  const float drop = drop_[slot];
   glm::mat4 placed = root;
-  if (drop > 0.0f) {
-    placed[3].y -= drop;
-    // Lowering the root lowers every joint by the same amount: no need for a second FK pass.
-    for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
-    // Free feet go down with the body; pinned ones stay where they are pinned.
-    for (int side = 0; side < 2; ++side) {
-      if (pinned[side]) toe_offset[side].y += drop;
-    }
-  }
+  placed[3].y -= drop;
+  // Lowering the root lowers every joint by the same amount: no need for a second FK pass.
+  for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
+
+  glm::quat ankle_world_rot[2];
+  bool use_ik[2] = {false, false};
+  glm::vec3 toe_offset[2];
   for (int side = 0; side < 2; ++side) {
+    const Side sd = static_cast<Side>(side);
+    const int ankle = skeleton_.ankle(sd);
+    // Pinned feet stay where they are pinned, and free ones keep the clips' height over the floor
+    // (the swing leg bends more): a lowered body never drags a swinging foot over the ground.
+    glm::vec3 g = goal[side];
+    const glm::vec3 drawn_ankle = translation_of(world_[base + ankle]);
+    const glm::vec3 drawn_toe = translation_of(world_[base + skeleton_.toe(sd)]);
+    // Never below the floor the clips were authored on: the whole foot is raised as far as its
+    // deeper joint needs.
+    const glm::vec3 ankle_goal = drawn_ankle + (g - drawn_toe);
+    const float raise = std::max(
+        {0.0f, library_.planted_toe_m[side] - g.y, library_.planted_ankle_m[side] - ankle_goal.y});
+    g.y += raise;
+    toe_offset[side] = g - drawn_toe;
+    use_ik[side] = glm::dot(toe_offset[side], toe_offset[side]) > 1e-10f;
+    ankle_world_rot[side] = rotation_of(world_[base + ankle]);
+  }
+  if (!use_ik[0] && !use_ik[1]) return;
+  for (int side = 0; side < 2; ++side) {
+    if (!use_ik[side]) continue;
     const Side sd = static_cast<Side>(side);
     const int hip = skeleton_.hip(sd), knee = skeleton_.knee(sd), ankle = skeleton_.ankle(sd);
     const size_t k = static_cast<size_t>(slot) * 2 + side;
-    ankle_world_rot[side] = rotation_of(world_[base + ankle]);
-    if (!use_ik[side]) continue;
     // IK: move the ankle by the toe's offset, keep the foot's world orientation.
     const glm::vec3 anim_ankle = translation_of(world_[base + ankle]);
-    const glm::vec3 goal_ankle = anim_ankle + toe_offset[side];
+    glm::vec3 goal_ankle = anim_ankle + toe_offset[side];
     const glm::vec3 hip_p = translation_of(world_[base + hip]);
-    const float reach = glm::length(goal_ankle - hip_p);
-    if (reach > P.max_leg_stretch * library_.leg_length_m[side] &&
-        locks_.state[k] == static_cast<uint8_t>(FootLockState::kLocked)) {
-      // Overstretched even with the pelvis down: let the foot go, smoothly.
-      locks_.state[k] = static_cast<uint8_t>(FootLockState::kReleasing);
-      locks_.from[k] = locks_.target[k];
-      locks_.timer[k] = 0.0f;
+    // The clip's own leg may be straighter than the limit (standing): only reaching further than
+    // both counts.
+    const float limit =
+        std::max(P.max_leg_stretch * library_.leg_length_m[side], glm::length(anim_ankle - hip_p));
+    // Heel-off: a leg that cannot reach its pinned foot raises the heel about the ball (the foot
+    // pitches up about the toe) as far as that takes, as a stance foot does before toe-off. The
+    // heel comes down again on a spring, so a released foot does not snap flat.
+    float& pitch = locks_.heel_pitch[k];
+    float& pitch_rate = locks_.heel_pitch_rate[k];
+    if (pl.fresh[slot]) pitch = pitch_rate = 0.0f;
+    const glm::vec3 toe_goal = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
+    float wanted = 0.0f;
+    glm::vec3 pitch_axis(0.0f);
+    const glm::vec3 d = goal_ankle - toe_goal;
+    if (glm::length(glm::cross(d, glm::vec3(0, 1, 0))) > 1e-6f) {
+      pitch_axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
+      if (glm::length(goal_ankle - hip_p) > limit &&
+          locks_.lock[k].state == FootLockState::kLocked) {
+        wanted = heel_off_pivot(toe_goal, goal_ankle, hip_p, limit);
+      }
+    }
+    if (wanted >= pitch) {
+      pitch = wanted;
+      pitch_rate = 0.0f;
+    } else {
+      critical_spring(pitch, pitch_rate, wanted, kHeelHalflife, dt);
+    }
+    if (pitch > 1e-5f && glm::length(pitch_axis) > 0.5f) {
+      const glm::quat r = glm::angleAxis(pitch, pitch_axis);
+      goal_ankle = toe_goal + r * d;
+      ankle_world_rot[side] = r * ankle_world_rot[side];
+    }
+    if (glm::length(goal_ankle - hip_p) > limit + 1e-3f &&
+        locks_.lock[k].state == FootLockState::kLocked) {
+      // Overstretched even with the pelvis down and the heel up: the foot steps to where the clip
+      // has it while the clip keeps it on the ground, and is let go when the clip lifts it.
+      const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
+      const bool other_locked =
+          locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
+      if (pl.plant[side][slot] >= 0.5f && other_locked) {
+        start_foot_step(locks_.lock[k], drawn);
+      } else {
+        release_foot_lock(locks_.lock[k], drawn, glm::vec3(0.0f),
+                          translation_of(world_[base + skeleton_.toe(sd)]), anim_vel[side]);
+      }
     }
     const glm::vec3 knee_p = translation_of(world_[base + knee]);
     const glm::vec3 axis = glm::normalize(anim_ankle - hip_p);

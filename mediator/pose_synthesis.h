@@ -13,22 +13,19 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 
+#include "mediator/foot_lock.h"
 #include "mediator/locomotion_library.h"
 #include "mediator/mediator.h"
 
 namespace gk {
 
-enum class FootLockState : uint8_t { kFree, kLocked, kReleasing, kStepping };
-
+// Per foot [slot * 2 + side].
 struct FootLocks {
-  std::vector<uint8_t> state;       // FootLockState, [slot * 2 + side]
-  std::vector<glm::vec3> target;    // locked toe position (world) [m]
-  std::vector<glm::vec3> from;      // stepping: where the step started
-  std::vector<float> weight;        // IK weight 0..1
-  std::vector<float> timer;         // stepping progress [s]
-  std::vector<glm::vec3> anim_toe;  // the clip's (unlocked) toe position last frame
-  std::vector<float> lift;          // swing clearance lift applied last frame [m]
-  std::vector<glm::vec3> drawn_toe; // the toe as drawn last frame (after IK) [m]
+  std::vector<FootLock> lock;          // the lock state machine (mediator/foot_lock.h)
+  std::vector<glm::vec3> anim_toe;     // the clip's (unlocked) toe position last frame [m]
+  std::vector<glm::vec3> drawn_toe;    // the toe as drawn last frame (after IK) [m]
+  std::vector<float> heel_pitch;       // heel raised about the ball by the pivot [rad]
+  std::vector<float> heel_pitch_rate;  // its rate [rad/s] (it settles back on a spring)
 };
 
 class PoseSynthesizer {
@@ -88,7 +85,8 @@ class PoseSynthesizer {
   std::vector<float> pelvis_heading_;
   std::vector<float> upper_heading_;
   std::vector<uint8_t> has_prev_;
-  std::vector<float> drop_;  // pelvis drop per slot [m]
+  std::vector<float> drop_;       // pelvis drop per slot [m]
+  std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   int first_leg_joint_ = 0;

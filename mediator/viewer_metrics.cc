@@ -89,32 +89,9 @@ std::string limb_joint_name(const Skeleton& sk, LimbJoint j, Side s) {
 FeetReference make_feet_reference(const LocomotionLibrary& library, float dt_s) {
   FeetReference ref;
   const Skeleton& sk = *library.skeleton;
-  std::vector<glm::mat4> model(sk.num_joints());
-  std::vector<float> toe_h[2], ankle_h[2];
   std::vector<float> accel[kNumLimbJoints][2];
   for (const LocomotionClip& lc : library.clips) {
     if (!locomotion(lc)) continue;
-    const Clip& c = lc.clip;
-    std::vector<uint8_t> contact(c.num_frames);
-    for (int s = 0; s < 2; ++s) {
-      std::fill(contact.begin(), contact.end(), 0);
-      for (const TimeInterval& iv : lc.analysis.contacts[s]) {
-        const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
-        const int b = static_cast<int>(std::lround(iv.end_s * c.fps));
-        for (int f = std::max(a, 0); f <= std::min(b, c.num_frames - 1); ++f) contact[f] = 1;
-      }
-      for (int f = 0; f < c.num_frames; ++f) {
-        if (!contact[f]) continue;
-        LocalToModelJob{&sk,
-                        {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
-                        {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
-                        glm::mat4(1.0f),
-                        model}
-            .run();
-        toe_h[s].push_back(model[sk.toe(static_cast<Side>(s))][3].y);
-        ankle_h[s].push_back(model[sk.ankle(static_cast<Side>(s))][3].y);
-      }
-    }
     const PlayedClip played = play_with_root_motion(lc, sk, dt_s);
     for (int j = 0; j < kNumLimbJoints; ++j) {
       for (int s = 0; s < 2; ++s) {
@@ -126,10 +103,8 @@ FeetReference make_feet_reference(const LocomotionLibrary& library, float dt_s) 
     }
   }
   for (int s = 0; s < 2; ++s) {
-    // Without analysed contacts the lowest heights stand in (a clip still has a lowest foot).
-    ref.toe_floor_m[s] = toe_h[s].empty() ? library.toe_floor_m[s] : percentile(toe_h[s], 0.5);
-    ref.ankle_floor_m[s] =
-        ankle_h[s].empty() ? library.ankle_floor_m[s] : percentile(ankle_h[s], 0.5);
+    ref.toe_floor_m[s] = library.planted_toe_m[s];
+    ref.ankle_floor_m[s] = library.planted_ankle_m[s];
     for (int j = 0; j < kNumLimbJoints; ++j) ref.accel_m_s2[j][s] = percentile(accel[j][s], 0.999);
   }
   return ref;

@@ -1,0 +1,158 @@
+#include "mediator/foot_lock.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/common.hpp>
+
+#include "mediator/springs.h"
+
+namespace gk {
+namespace {
+
+// 0 -> 1 with zero slope at both ends.
+float smoothstep01(float x) {
+  x = std::clamp(x, 0.0f, 1.0f);
+  return x * x * (3.0f - 2.0f * x);
+}
+
+// Decays an inertialization offset toward zero (Holden's decay spring: exact for any dt).
+void decay_offset(glm::vec3& x, glm::vec3& v, float halflife_s, float dt) {
+  critical_spring(x, v, glm::vec3(0.0f), halflife_s, dt);
+}
+
+}  // namespace
+
+void release_foot_lock(FootLock& lock, const glm::vec3& drawn_toe, const glm::vec3& drawn_vel,
+                       const glm::vec3& anim_toe, const glm::vec3& anim_vel) {
+  lock.state = FootLockState::kReleasing;
+  lock.from = drawn_toe;
+  lock.offset = drawn_toe - anim_toe;
+  lock.offset_vel = drawn_vel - anim_vel;
+  lock.shed = 0.0f;
+  lock.swing_from = -1.0f;  // taken from the first frame's progress
+}
+
+void start_foot_step(FootLock& lock, const glm::vec3& from) {
+  lock.state = FootLockState::kStepping;
+  lock.from = from;
+  lock.timer_s = 0.0f;
+  lock.offset = lock.offset_vel = glm::vec3(0.0f);
+}
+
+namespace {
+
+glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams& p, float dt) {
+  const glm::vec3 anim_vel = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
+  auto lock_here = [&](const glm::vec3& at) {
+    lock.state = FootLockState::kLocked;
+    lock.target = glm::vec3(at.x, std::max(in.floor_toe_m, in.anim_toe.y), at.z);
+    // Vertically the foot settles (it may still be coming down); horizontally it stops.
+    const float drawn_y = in.fresh ? in.anim_toe.y : in.drawn_toe_prev.y;
+    lock.offset = glm::vec3(0.0f, drawn_y - std::max(in.floor_toe_m, in.anim_toe.y), 0.0f);
+    lock.offset_vel = glm::vec3(0.0f);
+  };
+  // Where the toe is drawn while pinned: it follows the clip's toe down onto the floor as the foot
+  // rolls from the heel onto the ball, and never up again while the ball bears weight (the heel
+  // rises about it); the clips lifting it ends the lock.
+  auto pinned_goal = [&] {
+    lock.target.y = std::min(lock.target.y, std::max(in.floor_toe_m, in.anim_toe.y));
+    return lock.target;
+  };
+
+  switch (lock.state) {
+    case FootLockState::kFree:
+    case FootLockState::kReleasing:
+      if (in.plant) {
+        // Pinned where it was drawn last frame: the foot stops on the frame it plants instead of
+        // taking one more step of the clip's (still slowing) foot.
+        lock_here(in.fresh ? in.anim_toe : in.drawn_toe_prev);
+      }
+      break;
+    case FootLockState::kLocked: {
+      if (!in.hold) {
+        release_foot_lock(lock, pinned_goal() + lock.offset, glm::vec3(0.0f), in.anim_toe,
+                          anim_vel);
+        break;
+      }
+      // A foot left behind by a turn or a drift re-plants with a short step, one foot at a time.
+      const float drift = std::hypot(lock.target.x - in.anim_toe.x, lock.target.z - in.anim_toe.z);
+      if (drift > p.step_distance_m && in.other_locked)
+        start_foot_step(lock, pinned_goal() + lock.offset);
+      break;
+    }
+    case FootLockState::kStepping:
+      // The clips lift the foot before the step is done: it joins their swing from where it is,
+      // at the speed it has.
+      if (!in.hold) {
+        release_foot_lock(lock, lock.last_goal, (lock.last_goal - in.drawn_toe_prev) / dt,
+                          in.anim_toe, anim_vel);
+      }
+      break;
+  }
+
+  if (lock.state != FootLockState::kReleasing) {
+    decay_offset(lock.offset, lock.offset_vel, p.release_halflife_s, dt);
+  }
+  switch (lock.state) {
+    case FootLockState::kFree:
+      return in.anim_toe + lock.offset;
+    case FootLockState::kReleasing: {
+      if (lock.swing_from < 0.0f) lock.swing_from = std::min(in.swing_progress, 0.9f);
+      // A progress that went back means the clips started a new swing: the old one is over.
+      const float span = 1.0f - lock.swing_from;
+      const float u = in.swing_progress + 0.05f < lock.swing_from
+                          ? 1.0f
+                          : (in.swing_progress - lock.swing_from) / span;
+      lock.shed = std::max(lock.shed, smoothstep01(u));
+      // Upward the foot follows the clip's lift at once (a spring, so the knee does not snap);
+      // sideways it is corrected over the swing.
+      if (lock.offset.y < 0.0f || lock.offset_vel.y != 0.0f) {
+        float y = lock.offset.y, vy = lock.offset_vel.y;
+        critical_spring(y, vy, 0.0f, 0.5f * p.release_halflife_s, dt);
+        lock.offset.y = y;
+        lock.offset_vel.y = vy;
+      }
+      glm::vec3 goal = in.anim_toe + lock.offset * (1.0f - lock.shed);
+      goal.y = in.anim_toe.y + lock.offset.y;
+      if (lock.shed >= 1.0f) {
+        lock.state = FootLockState::kFree;
+        lock.offset = lock.offset_vel = glm::vec3(0.0f);
+      }
+      return goal;
+    }
+    case FootLockState::kLocked:
+      return pinned_goal() + lock.offset;
+    case FootLockState::kStepping: {
+      // Lifted and carried to where the clip has the foot, with zero speed at both ends (no snap);
+      // as high as the clips' own swing.
+      lock.timer_s += dt;
+      const float u = std::min(1.0f, lock.timer_s / p.step_time_s);
+      const float s = std::sin(std::numbers::pi_v<float> * u);
+      const glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
+      glm::vec3 goal = glm::mix(lock.from, to, smoothstep01(u));
+      goal.y += p.step_height_m * s * s;
+      if (u >= 1.0f) {
+        lock.state = FootLockState::kLocked;
+        lock.target = to;
+      }
+      return goal;
+    }
+  }
+  return in.anim_toe;
+}
+
+}  // namespace
+
+glm::vec3 step_foot_lock(FootLock& lock, const FootLockInput& in, const FootLockParams& p,
+                         float dt) {
+  if (in.fresh) {
+    lock = FootLock();
+    lock.last_goal = in.anim_toe;
+  }
+  lock.last_goal = advance(lock, in, p, dt);
+  return lock.last_goal;
+}
+
+}  // namespace gk
