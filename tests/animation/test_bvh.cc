@@ -375,5 +375,17 @@ TEST(BvhFixtures, DirectoryIsNotABvhFile) {
   EXPECT_EQ(set.message(), dir + ": is a directory, expected a BVH file");
 }
 
+// Issue #12: analyze-clip on an empty folder printed nothing and exited 0.
+TEST(ClipLibrary, FolderWithoutClipsIsAnError) {
+  const std::string dir = test::scratch_dir("clip_library_empty");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/notes.txt") << "no clips here\n";
+  Result<std::vector<std::string>> paths = expand_clip_paths({dir});
+  ASSERT_FALSE(paths.ok());
+  EXPECT_EQ(paths.message(),
+            dir + ": the folder holds no clips (expected .bvh, .gltf or .glb files)");
+}
+
 }  // namespace
 }  // namespace gk
