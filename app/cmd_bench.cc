@@ -81,6 +81,9 @@ std::vector<std::string> split_names(const std::string& list) {
 
 void run_bench(const BenchOptions& o) {
   const int frames = parse_number<int>("bench", o.frames, "--frames", 1, kMaxFrames);
+  // Output paths are checked before the work starts, not after minutes of simulation.
+  check_output_file_option("bench", o.json, "--json");
+  check_output_file_option("bench", o.dump_joints, "--dump-joints");
   std::unique_ptr<CrowdSession> session = CrowdSession::create(o.crowd);
   CrowdSource& crowd = session->crowd();
   if (frames <= kWarmupFrames) {
