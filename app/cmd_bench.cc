@@ -28,6 +28,9 @@ namespace {
 constexpr int kWarmupFrames = 30;
 constexpr float kMinPairSearch_m = 3.0f;  // closest-approach search radius of the statistics
 constexpr int kMaxFrames = 10'000'000;
+// MetricsRecorder reserves agents x frames_hint samples up front: a hint of a minute keeps a long
+// run (up to kMaxFrames) from reserving gigabytes before its first frame; vectors grow past it.
+constexpr int kMaxMetricsFramesHint = 3600;
 
 struct BenchOptions {
   CrowdOptions crowd;
@@ -94,7 +97,7 @@ void run_bench(const BenchOptions& o) {
   const MediatorParams& params = session->params();
   const size_t capacity = std::max<size_t>(crowd.capacity(), 1);
   MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity,
-                          static_cast<size_t>(frames));
+                          static_cast<size_t>(std::min(frames, kMaxMetricsFramesHint)));
   std::optional<JointDumpWriter> dump;
   if (!o.dump_joints.empty()) {
     auto opened =
