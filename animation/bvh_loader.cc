@@ -3,13 +3,14 @@
 #include "animation/bvh_loader.h"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include <glm/gtc/quaternion.hpp>
 
 #include "animation/loader_internal.h"
 #include "animation/text_scanner.h"
+#include "common/file_io.h"
+#include "common/text_snippet.h"
 
 namespace gk {
 namespace {
@@ -47,10 +48,13 @@ bool channel_from_name(std::string_view s, Channel* out) {
   return false;
 }
 
+// A token from the file as echoed in messages (printable: a binary file is no text).
 std::string quoted(std::string_view token) {
   if (token.empty()) return "end of file";
-  return "'" + std::string(token.substr(0, 40)) + "'";
+  return quoted_snippet(token);
 }
+
+constexpr uint64_t kMaxFileBytes = uint64_t(1) << 30;  // hours of mocap; refuse anything absurd
 
 class BvhParser {
  public:
@@ -135,8 +139,8 @@ Status BvhParser::parse_joint(int parent, int depth) {
     const int tok_line = scan_.line();
     if (tok == "}") return Status::Ok();
     if (tok.empty()) {
-      return error(tok_line, "unexpected end of file inside joint '" + joints_[self].name +
-                                 "' (expected '}')");
+      return error(tok_line, "unexpected end of file inside joint " +
+                                 quoted_snippet(joints_[self].name, 80) + " (expected '}')");
     }
     if (tok == "OFFSET") {
       GK_RETURN_IF_ERROR(read_vec3(&joints_[self].offset));
@@ -412,12 +416,9 @@ Result<ClipSet> parse_bvh(std::string_view text, const std::string& source_name,
 }
 
 Result<ClipSet> load_bvh(const std::string& path, const LoadOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(path + ": cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return Status::Error(path + ": read error");
-  return parse_bvh(ss.str(), path, options);
+  Result<std::string> text = read_file_bytes(path, kMaxFileBytes, "BVH file");
+  if (!text.ok()) return text.status();
+  return parse_bvh(*text, path, options);
 }
 
 }  // namespace gk

@@ -45,6 +45,10 @@ Result<std::vector<std::string>> expand_clip_paths(const std::vector<std::string
         }
       }
       if (ec) return Status::Error(path + ": cannot list folder: " + ec.message());
+      if (found.empty()) {
+        return Status::Error(path +
+                             ": the folder holds no clips (expected .bvh, .gltf or .glb files)");
+      }
       std::sort(found.begin(), found.end());
       out.insert(out.end(), found.begin(), found.end());
     } else if (std::filesystem::exists(path, ec)) {

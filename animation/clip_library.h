@@ -12,7 +12,8 @@ namespace gk {
 // Loads one file by extension.
 Result<ClipSet> load_clip_file(const std::string& path, const LoadOptions& options = {});
 
-// Expands folders (non-recursive, sorted by name) into the clip files they contain.
+// Expands folders (non-recursive, sorted by name) into the clip files they contain; a folder
+// without any .bvh/.gltf/.glb file is an error (naming it), not an empty result.
 Result<std::vector<std::string>> expand_clip_paths(const std::vector<std::string>& paths);
 
 }  // namespace gk

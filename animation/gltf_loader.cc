@@ -14,6 +14,8 @@
 #include "animation/gltf_internal.h"
 #include "animation/loader_internal.h"
 #include "animation/mesh.h"
+#include "common/file_io.h"
+#include "common/text_snippet.h"
 
 namespace gk {
 namespace {
@@ -330,6 +332,7 @@ void apply_scale(float s, Skeleton* skeleton, std::vector<Clip>* clips,
 }  // namespace
 
 Result<ClipSet> load_gltf(const std::string& path, const LoadOptions& options) {
+  GK_RETURN_IF_ERROR(check_input_file(path, "glTF file"));
   tinygltf::TinyGLTF loader;
   tinygltf::Model model;
   std::string err, warn;
@@ -337,7 +340,12 @@ Result<ClipSet> load_gltf(const std::string& path, const LoadOptions& options) {
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
                                 : loader.LoadASCIIFromFile(&model, &err, &warn, path);
-  if (!ok) return Status::Error(path + ": " + (err.empty() ? "cannot load glTF" : err));
+  // tinygltf's errors may quote the file (a JSON parse error of a binary file): keep them
+  // printable.
+  if (!ok) {
+    return Status::Error(path + ": " +
+                         (err.empty() ? "cannot load glTF" : printable_snippet(err, 400)));
+  }
   if (model.skins.empty()) return Status::AtField(path, "skins", "no skin (a skeleton is needed)");
 
   // Parent of every node, rejecting shared children and cycles before anything walks up the tree.

@@ -6,13 +6,17 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "common/file_io.h"
+#include "common/json_text.h"
+#include "common/text_snippet.h"
+
 namespace gk {
 namespace {
+
+constexpr uint64_t kMaxManifestBytes = 1u << 20;  // a manifest names a few dozen joints
 
 constexpr std::array<std::string_view, kNumJointRoles> kRoleNames = {
     "hips",       "spine",       "chest",      "neck",          "head",
@@ -298,8 +302,9 @@ void detect_joint_roles(Skeleton* s) {
 
 Status apply_role_manifest_text(std::string_view json_text, const std::string& source_name,
                                 Skeleton* skeleton) {
-  nlohmann::json doc = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded()) return Status::Error(source_name + ": not valid JSON");
+  Result<nlohmann::json> parsed = parse_json_text(json_text, source_name);
+  if (!parsed.ok()) return parsed.status();
+  const nlohmann::json& doc = *parsed;
   if (!doc.is_object() || !doc.contains("roles")) {
     return Status::AtField(source_name, "roles", "missing (expected {\"roles\": {...}})");
   }
@@ -309,7 +314,7 @@ Status apply_role_manifest_text(std::string_view json_text, const std::string& s
   }
   Skeleton updated = *skeleton;
   for (const auto& [key, value] : roles.items()) {
-    const std::string field = "roles." + key;
+    const std::string field = "roles." + printable_snippet(key, 80);
     JointRole role;
     if (!joint_role_from_name(key, &role)) {
       std::string known;
@@ -325,8 +330,9 @@ Status apply_role_manifest_text(std::string_view json_text, const std::string& s
     }
     const int j = updated.find(value.get<std::string>());
     if (j < 0) {
-      return Status::AtField(source_name, field,
-                             "no joint named '" + value.get<std::string>() + "' in the skeleton");
+      return Status::AtField(
+          source_name, field,
+          "no joint named " + quoted_snippet(value.get<std::string>(), 80) + " in the skeleton");
     }
     set_role(&updated, role, j);
   }
@@ -344,11 +350,9 @@ Status apply_role_manifest_text(std::string_view json_text, const std::string& s
 }
 
 Status apply_role_manifest(const std::string& manifest_path, Skeleton* skeleton) {
-  std::ifstream in(manifest_path, std::ios::binary);
-  if (!in) return Status::Error(manifest_path + ": cannot open role manifest");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return apply_role_manifest_text(ss.str(), manifest_path, skeleton);
+  Result<std::string> text = read_file_bytes(manifest_path, kMaxManifestBytes, "role manifest");
+  if (!text.ok()) return text.status();
+  return apply_role_manifest_text(*text, manifest_path, skeleton);
 }
 
 Status validate_skeleton(const Skeleton& s, const std::string& source_name) {
@@ -360,7 +364,7 @@ Status validate_skeleton(const Skeleton& s, const std::string& source_name) {
     return Status::Error(source_name + ": skeleton arrays disagree in size");
   }
   for (size_t i = 0; i < n; ++i) {
-    const std::string where = "joint " + std::to_string(i) + " '" + s.names[i] + "'";
+    const std::string where = "joint " + std::to_string(i) + " " + quoted_snippet(s.names[i], 80);
     if (s.parents[i] < -1 || s.parents[i] >= static_cast<int>(i)) {
       return Status::AtField(source_name, where,
                              "parent " + std::to_string(s.parents[i]) + " is not an earlier joint");

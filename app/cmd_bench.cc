@@ -28,6 +28,9 @@ namespace {
 constexpr int kWarmupFrames = 30;
 constexpr float kMinPairSearch_m = 3.0f;  // closest-approach search radius of the statistics
 constexpr int kMaxFrames = 10'000'000;
+// MetricsRecorder reserves agents x frames_hint samples up front: a hint of a minute keeps a long
+// run (up to kMaxFrames) from reserving gigabytes before its first frame; vectors grow past it.
+constexpr int kMaxMetricsFramesHint = 3600;
 
 struct BenchOptions {
   CrowdOptions crowd;
@@ -81,6 +84,9 @@ std::vector<std::string> split_names(const std::string& list) {
 
 void run_bench(const BenchOptions& o) {
   const int frames = parse_number<int>("bench", o.frames, "--frames", 1, kMaxFrames);
+  // Output paths are checked before the work starts, not after minutes of simulation.
+  check_output_file_option("bench", o.json, "--json");
+  check_output_file_option("bench", o.dump_joints, "--dump-joints");
   std::unique_ptr<CrowdSession> session = CrowdSession::create(o.crowd);
   CrowdSource& crowd = session->crowd();
   if (frames <= kWarmupFrames) {
@@ -91,7 +97,7 @@ void run_bench(const BenchOptions& o) {
   const MediatorParams& params = session->params();
   const size_t capacity = std::max<size_t>(crowd.capacity(), 1);
   MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity,
-                          static_cast<size_t>(frames));
+                          static_cast<size_t>(std::min(frames, kMaxMetricsFramesHint)));
   std::optional<JointDumpWriter> dump;
   if (!o.dump_joints.empty()) {
     auto opened =

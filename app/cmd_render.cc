@@ -20,6 +20,7 @@
 #include "app/crowd_session.h"
 #include "app/offscreen.h"
 #include "app/overlays.h"
+#include "common/file_io.h"
 #include "render/frame_capture.h"
 #include "render/label_font.h"
 
@@ -119,7 +120,20 @@ void run_render(RenderOptions& o) {
   const OverlayToggles overlays = parse_overlays(o.overlays);
   const int64_t follow =
       o.follow.empty() ? -1 : parse_number<int>(kCmd, o.follow, "--follow", 0, 1 << 30);
+  // Output paths are checked before the work starts, not after seconds of simulation.
+  if (kind == OutputKind::kFolder) {
+    if (Status s = check_output_folder(o.out, "--out"); !s.ok()) fail(kCmd, 2, s.message());
+  } else {
+    check_output_file_option(kCmd, o.out, "--out");
+  }
+  check_output_file_option(kCmd, o.report, "--report");
   std::unique_ptr<CrowdSession> session = CrowdSession::create(o.crowd);
+  if (follow >= 0) check_agent_id(kCmd, session->setup(), follow, "--follow");
+  if (kind == OutputKind::kFolder) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.out, ec);
+    if (ec) fail(kCmd, 1, o.out + ": cannot create the folder: " + ec.message());
+  }
   if (o.compare) session->enable_compare(MediatorMode::kNaive);
   OffscreenScene scene = open_offscreen_scene(kCmd, *session, o.size);
   if (o.compare) {
@@ -132,11 +146,6 @@ void run_render(RenderOptions& o) {
   // Overlays are teaching aids: they stay visible through the bodies.
   scene.view->renderer().settings().lines_on_top = overlays.any();
 
-  if (kind == OutputKind::kFolder) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.out, ec);
-    if (ec) fail(kCmd, 1, o.out + ": cannot create the folder: " + ec.message());
-  }
   FILE* video = nullptr;
   if (kind == OutputKind::kVideo) {
     if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {

@@ -1,5 +1,6 @@
 #include "app/crowd_setup.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <limits>
@@ -9,6 +10,7 @@
 #include "animation/clip_library.h"
 #include "animation/procedural.h"
 #include "app/commands.h"
+#include "common/file_io.h"
 #include "crowd/detour_crowd.h"
 #include "crowd/social_forces.h"
 #include "crowd/trajectory_replay.h"
@@ -48,6 +50,38 @@ template float parse_number<float>(const std::string&, const std::string&, const
                                    float);
 template uint64_t parse_number<uint64_t>(const std::string&, const std::string&, const char*,
                                          uint64_t, uint64_t);
+
+int max_cli_agents() {
+  return static_cast<int>(std::min<size_t>(SocialForceParams{}.max_agents, kMaxScenarioAgents));
+}
+
+void check_agent_id(const std::string& command, const CrowdSetup& setup, int64_t id,
+                    const std::string& option) {
+  const std::string what = option + " " + std::to_string(id) + ": ";
+  if (!setup.replay_ids.empty()) {
+    const auto& ids = setup.replay_ids;
+    if (id >= 0 && id <= std::numeric_limits<uint32_t>::max() &&
+        std::binary_search(ids.begin(), ids.end(), static_cast<uint32_t>(id))) {
+      return;
+    }
+    fail(command, 2,
+         what + "no pedestrian with that id in " + setup.scenario_name + " (its " +
+             std::to_string(ids.size()) + " pedestrian ids run from " +
+             std::to_string(ids.front()) + " to " + std::to_string(ids.back()) + ")");
+  }
+  if (setup.agents <= 0) fail(command, 2, what + "the crowd has no agents");
+  if (id < 0 || id >= setup.agents) {
+    fail(command, 2,
+         what + "no agent with that id; expected an id in [0, " + std::to_string(setup.agents - 1) +
+             "] (" + setup.scenario_name + " has " + std::to_string(setup.agents) + " agents)");
+  }
+}
+
+void check_output_file_option(const std::string& command, const std::string& path,
+                              const std::string& option) {
+  if (path.empty()) return;
+  if (Status s = check_output_file(path, option); !s.ok()) fail(command, 2, s.message());
+}
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
@@ -96,7 +130,7 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
     ReplayOptions replay;
     replay.frame_time_s =
         parse_number<float>(cmd, o.trajectory_frame_time, "--trajectory-frame-time", 1e-3f, 60.0f);
-    auto loaded = load_trajectory_replay(o.scenario, replay);
+    auto loaded = load_trajectory_replay(o.scenario, replay, &src.replay_ids);
     if (!loaded.ok()) fail(cmd, 2, loaded.message());
     src.crowd = std::move(loaded).value();
     src.scenario_name = o.scenario;
@@ -105,9 +139,17 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
   }
   auto loaded = load_scenario_by_name(o.scenario, scenario_dir());
   if (!loaded.ok()) fail(cmd, 2, loaded.message());
+  // Checked before any setup work: expanding and building a crowd beyond the simulator's limit
+  // takes many seconds only to be refused.
   const int num_agents = o.agents.empty()
                              ? loaded->default_agents
-                             : parse_number<int>(cmd, o.agents, "--agents", 0, kMaxScenarioAgents);
+                             : parse_number<int>(cmd, o.agents, "--agents", 0, max_cli_agents());
+  if (num_agents > max_cli_agents()) {
+    fail(cmd, 2,
+         loaded->source + ": default_agents " + std::to_string(num_agents) +
+             " exceeds the limit of " + std::to_string(max_cli_agents()) +
+             " agents; pass a smaller --agents");
+  }
   const Scenario scenario = scale_scenario(*loaded, num_agents);
   auto agents = expand_agents(scenario, num_agents, seed);
   if (!agents.ok()) fail(cmd, 2, agents.message());

@@ -61,12 +61,31 @@ struct CrowdSetup {
   std::vector<WallSegment> walls;
   glm::vec2 bounds_min{-10.0f}, bounds_max{10.0f};
   bool has_bounds = false;
+  // A replayed file's pedestrian ids (sorted); empty for a simulated crowd, whose ids are
+  // 0 .. agents - 1.
+  std::vector<uint32_t> replay_ids;
 };
+
+// The largest crowd the command line accepts (--agents, or a scenario's default_agents): the
+// social-forces simulator's max_agents, so that a bigger crowd is refused before any setup work.
+int max_cli_agents();
 
 CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed);
 // The clip library: the built-in set, or the given files and folders (one clip set per file).
 LocomotionLibrary load_library(const CrowdOptions& o);
 MediatorParams make_params(const CrowdOptions& o, uint64_t seed);
+
+// Ends the command (exit 2) unless `id` names an agent that can appear in this crowd: an id in
+// [0, agents) for a simulated scenario, a pedestrian id of the file for a replay. `option` names
+// the option in the message ("--follow").
+void check_agent_id(const std::string& command, const CrowdSetup& setup, int64_t id,
+                    const std::string& option);
+
+// Ends the command (exit 2) unless a file can be written at `path` (its folder exists and is
+// writable; it is not a folder), so that a bad output path fails before the work starts. An empty
+// path (option not given) passes.
+void check_output_file_option(const std::string& command, const std::string& path,
+                              const std::string& option);
 
 bool ends_with(const std::string& s, const std::string& suffix);
 

@@ -236,7 +236,9 @@ void DemoApp::write_report(const std::string& path) const {
                             {"selected", selected_id_},
                             {"panel", {panel_rect_.x, panel_rect_.y, panel_rect_.z, panel_rect_.w}},
                             {"agents", agents}};
-  std::ofstream(path) << j.dump(1) << "\n";
+  std::ofstream out(path);
+  out << j.dump(1) << "\n";
+  if (!out) fail("demo", 1, path + ": cannot write the report");
 }
 
 int DemoApp::run() {
@@ -250,6 +252,9 @@ int DemoApp::run() {
   const int frames_to_run =
       options_.frames.empty() ? -1
                               : parse_number<int>("demo", options_.frames, "--frames", 1, 1 << 30);
+  // Output paths are checked before the window opens and the frames run.
+  check_output_file_option("demo", options_.screenshot, "--screenshot");
+  check_output_file_option("demo", options_.report, "--report");
   ContextOptions co;
   co.width = size.x;
   co.height = size.y;
@@ -269,6 +274,7 @@ int DemoApp::run() {
   }
   if (!options_.select.empty()) {
     selected_id_ = parse_number<int>("demo", options_.select, "--select", 0, 1 << 30);
+    check_agent_id("demo", session_->setup(), selected_id_, "--select");
     follow_ = true;
     camera_.distance_m = std::min(camera_.distance_m, 9.0f);
   }

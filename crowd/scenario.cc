@@ -6,13 +6,15 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <limits>
-#include <sstream>
 
 #include <glm/common.hpp>
 #include <nlohmann/json.hpp>
+
+#include "common/file_io.h"
+#include "common/json_text.h"
+#include "common/text_snippet.h"
 
 namespace gk {
 namespace {
@@ -45,7 +47,8 @@ class Parser {
   explicit Parser(std::string file) : file_(std::move(file)) {}
 
   Status error(const std::string& path, const std::string& what) const {
-    return Status::AtField(file_, path, what);
+    // Keys come from the file: quote them printably.
+    return Status::AtField(file_, printable_snippet(path, 200), what);
   }
 
   // Rejects keys that are not in `allowed`, so a typo does not silently fall back to a default.
@@ -345,32 +348,19 @@ class Parser {
 
 Result<Scenario> parse_scenario(std::string_view json_text, const std::string& source_name) {
   const Parser parser(source_name);
-  json root;
-  try {
-    root = json::parse(json_text.begin(), json_text.end(), nullptr, true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
-    // e.what() reads "[json.exception.parse_error.101] parse error at line L, column C: ...".
-    std::string what = e.what();
-    if (const size_t at = what.find("] "); at != std::string::npos) what = what.substr(at + 2);
-    return Status::Error(source_name + ": invalid JSON: " + what);
-  }
+  Result<json> root = parse_json_text(json_text, source_name, /*ignore_comments=*/true);
+  if (!root.ok()) return root.status();
   Scenario scenario;
   scenario.source = source_name;
-  GK_RETURN_IF_ERROR(parser.scenario(root, &scenario));
+  GK_RETURN_IF_ERROR(parser.scenario(*root, &scenario));
   if (scenario.name.empty()) scenario.name = std::filesystem::path(source_name).stem().string();
   return scenario;
 }
 
 Result<Scenario> load_scenario(const std::string& path) {
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) return Status::Error(path + ": cannot open scenario file (" + ec.message() + ")");
-  if (size > kMaxFileBytes) return Status::Error(path + ": file larger than 16 MB");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(path + ": cannot open scenario file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scenario(text.str(), path);
+  Result<std::string> text = read_file_bytes(path, kMaxFileBytes, "scenario file");
+  if (!text.ok()) return text.status();
+  return parse_scenario(*text, path);
 }
 
 Result<Scenario> load_scenario_by_name(const std::string& name_or_path,

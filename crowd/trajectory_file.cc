@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <tuple>
+
+#include "common/file_io.h"
+#include "common/text_snippet.h"
 
 namespace gk {
 namespace {
@@ -15,7 +17,7 @@ namespace {
 constexpr double kMaxFrame = 2147483647.0;
 constexpr double kMaxId = 4294967295.0;
 constexpr double kMaxCoordinate_m = 1.0e5;
-constexpr std::streamoff kMaxFileBytes = std::streamoff(1) << 30;
+constexpr uint64_t kMaxFileBytes = uint64_t(1) << 30;
 
 struct Row {
   uint32_t id;
@@ -47,14 +49,13 @@ Status parse_number(std::string_view token, const char* column, const std::strin
   double value = 0.0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
   if (ec != std::errc() || end != token.data() + token.size()) {
-    return Status::AtLine(file, line,
-                          std::string(column) + ": expected a number, found '" +
-                              std::string(token.substr(0, 40)) + "'");
+    return Status::AtLine(
+        file, line, std::string(column) + ": expected a number, found " + quoted_snippet(token));
   }
   if (!std::isfinite(value)) {
-    return Status::AtLine(file, line,
-                          std::string(column) + ": expected a finite number, found '" +
-                              std::string(token.substr(0, 40)) + "'");
+    return Status::AtLine(
+        file, line,
+        std::string(column) + ": expected a finite number, found " + quoted_snippet(token));
   }
   *out_value = value;
   return Status::Ok();
@@ -74,20 +75,20 @@ Status parse_row(std::string_view text, const std::string& file, int line, Row* 
     GK_RETURN_IF_ERROR(parse_number(tokens[c], kColumns[c], file, line, &values[c]));
   }
   if (values[0] < 0.0 || values[0] > kMaxFrame || values[0] != std::floor(values[0])) {
-    return Status::AtLine(
-        file, line,
-        "column 1 (frame): expected a whole number in [0, 2^31), found " + std::string(tokens[0]));
+    return Status::AtLine(file, line,
+                          "column 1 (frame): expected a whole number in [0, 2^31), found " +
+                              quoted_snippet(tokens[0]));
   }
   if (values[1] < 0.0 || values[1] > kMaxId || values[1] != std::floor(values[1])) {
     return Status::AtLine(
         file, line,
-        "column 2 (id): expected a whole number in [0, 2^32), found " + std::string(tokens[1]));
+        "column 2 (id): expected a whole number in [0, 2^32), found " + quoted_snippet(tokens[1]));
   }
   for (int c = 2; c < 4; ++c) {
     if (std::abs(values[c]) > kMaxCoordinate_m) {
       return Status::AtLine(file, line,
                             std::string(kColumns[c]) + ": expected a coordinate within +-1e5 m, " +
-                                "found " + std::string(tokens[c]));
+                                "found " + quoted_snippet(tokens[c]));
     }
   }
   out_row->frame = static_cast<int64_t>(values[0]);
@@ -187,18 +188,9 @@ Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::
 }
 
 Result<TrajectoryTable> read_trajectory_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return Status::AtLine(path, 0, "cannot open the file");
-  const std::streamoff size = in.tellg();
-  if (size < 0) return Status::AtLine(path, 0, "cannot read the file size");
-  if (size > kMaxFileBytes) {
-    return Status::AtLine(path, 0,
-                          "file too large (" + std::to_string(size) + " bytes, max 1 GiB)");
-  }
-  std::string text(static_cast<size_t>(size), '\0');
-  in.seekg(0);
-  if (size > 0 && !in.read(text.data(), size)) return Status::AtLine(path, 0, "read failed");
-  return parse_trajectory_text(text, path);
+  Result<std::string> text = read_file_bytes(path, kMaxFileBytes, "trajectory file");
+  if (!text.ok()) return text.status();
+  return parse_trajectory_text(*text, path);
 }
 
 }  // namespace gk

@@ -242,8 +242,9 @@ void TrajectoryReplay::update_live(float dt_s) {
 
 }  // namespace
 
-Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(const std::string& path,
-                                                            const ReplayOptions& options) {
+Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(
+    const std::string& path, const ReplayOptions& options,
+    std::vector<uint32_t>* out_pedestrian_ids) {
   if (!std::isfinite(options.frame_time_s) || options.frame_time_s <= 0.0f) {
     return Status::AtField(path, "frame_time_s",
                            "expected a finite time > 0 s per sample step, found " +
@@ -251,6 +252,7 @@ Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(const std::string& p
   }
   Result<TrajectoryTable> table = read_trajectory_file(path);
   if (!table.ok()) return table.status();
+  if (out_pedestrian_ids) *out_pedestrian_ids = table->ped_ids;  // sorted: tracks are by id
   const size_t slash = path.find_last_of('/');
   std::string name = "replay " + (slash == std::string::npos ? path : path.substr(slash + 1));
   return std::unique_ptr<CrowdSource>(

@@ -20,6 +20,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "crowd/crowd_source.h"
 
@@ -32,7 +33,10 @@ struct ReplayOptions {
   float frame_time_s = 0.4f;
 };
 
-Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(const std::string& path,
-                                                            const ReplayOptions& options = {});
+// `out_pedestrian_ids` (optional) receives every pedestrian id of the file, sorted, so that an
+// option naming an agent can be checked before the replay runs.
+Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(
+    const std::string& path, const ReplayOptions& options = {},
+    std::vector<uint32_t>* out_pedestrian_ids = nullptr);
 
 }  // namespace gk

@@ -1,13 +1,18 @@
 #include "mediator/params.h"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "common/file_io.h"
+#include "common/json_text.h"
+#include "common/text_snippet.h"
+
 namespace gk {
 namespace {
+
+constexpr uint64_t kMaxParamFileBytes = 1u << 20;  // a parameter file is a few hundred bytes
 
 using K = ParamInfo::Kind;
 using P = MediatorParams;
@@ -98,7 +103,7 @@ Result<MediatorMode> parse_mediator_mode(std::string_view name) {
   if (name == "naive") return MediatorMode::kNaive;
   if (name == "rate") return MediatorMode::kRate;
   if (name == "apm") return MediatorMode::kApm;
-  return Status::Error("mode: expected naive, rate or apm, got '" + std::string(name) + "'");
+  return Status::Error("mode: expected naive, rate or apm, got " + quoted_snippet(name));
 }
 
 std::span<const ParamInfo> mediator_param_infos() { return kInfos; }
@@ -150,17 +155,14 @@ Status set_mediator_param(std::string_view assignment, MediatorParams* params) {
 }
 
 Status load_mediator_params_json(const std::string& path, MediatorParams* params) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open parameter file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    return Status::Error(path + ": invalid JSON: " + e.what());
-  }
+  Result<std::string> text = read_file_bytes(path, kMaxParamFileBytes, "parameter file");
+  if (!text.ok()) return text.status();
+  Result<nlohmann::json> parsed = parse_json_text(*text, path);
+  if (!parsed.ok()) return parsed.status();
+  const nlohmann::json& j = *parsed;
   if (!j.is_object()) return Status::Error(path + ": expected a JSON object of parameters");
   for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string where = path + ": " + it.key();
+    const std::string where = path + ": " + printable_snippet(it.key(), 80);
     if (it.key() == "mode") {
       if (!it->is_string())
         return Status::Error(where + ": expected \"naive\", \"rate\" or \"apm\"");

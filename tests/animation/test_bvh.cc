@@ -1,6 +1,7 @@
 // BVH loading: the real CMU and UAL clips against the numbers in PROVENANCE.md, the hand-written
 // fixtures in tests/data/{good,bad}, unit-scale detection and the clip library entry points.
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "animation/bvh_loader.h"
 #include "animation/clip_library.h"
 #include "animation/pose_jobs.h"
+#include "common/text_snippet.h"
 #include "tests/test_data.h"
 
 namespace gk {
@@ -320,6 +322,69 @@ TEST(ClipLibrary, LoadsByExtensionCaseInsensitiveAndExpandsFolders) {
   EXPECT_NE(txt.message().find("unknown clip file type '.txt'"), std::string::npos);
   EXPECT_FALSE(expand_clip_paths({dir + "/missing"}).ok());
   EXPECT_FALSE(load_clip_file(dir + "/missing.bvh").ok());
+}
+
+// True when every byte is printable ASCII or a newline: no raw file bytes reached the message.
+bool printable_ascii(const std::string& s) {
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return (c >= 0x20 && c < 0x7F) || c == '\n'; });
+}
+
+// Issue #12: the shared helper every loader uses to quote file content.
+TEST(PrintableSnippet, EscapesControlBytesAndBrokenUtf8KeepsText) {
+  EXPECT_EQ(printable_snippet("HIERARCHY"), "HIERARCHY");
+  EXPECT_EQ(printable_snippet(std::string("a\0b\x1b[2J\t\r\n", 10)), "a\\x00b\\x1b[2J\\t\\r\\n");
+  EXPECT_EQ(printable_snippet("\xff\xfe\x80 ok"), "\\xff\\xfe\\x80 ok");
+  EXPECT_EQ(printable_snippet("Hüfte 腰"), "Hüfte 腰");  // well-formed UTF-8 stays
+  EXPECT_EQ(printable_snippet("\xc2\x9b"
+                              "31m"),
+            "\\xc2\\x9b31m");                                       // C1 CSI is a control
+  EXPECT_EQ(printable_snippet("\xed\xa0\x80"), "\\xed\\xa0\\x80");  // a surrogate is not UTF-8
+  EXPECT_EQ(printable_snippet(std::string(100, 'x'), 40), std::string(40, 'x') + "...");
+  EXPECT_EQ(quoted_snippet("\x7f"
+                           "ELF"),
+            "'\\x7fELF'");
+}
+
+// Issue #12: a binary file given as BVH echoed its raw bytes into the error message.
+TEST(BvhFixtures, BinaryFileIsQuotedPrintably) {
+  static constexpr char kBytes[] =
+      "\x7f"
+      "ELF\x02\x01\x01\x00\x00\x1b]0;pwned\x07\xff\xfe\n\x00";
+  const std::string path = test::scratch_dir("bvh_binary") + "/binary.bvh";
+  std::ofstream(path, std::ios::binary) << std::string(kBytes, sizeof(kBytes) - 1);
+  Result<ClipSet> set = load_bvh(path);
+  ASSERT_FALSE(set.ok());
+  EXPECT_EQ(set.message(), path + ":1: expected 'HIERARCHY', found " +
+                               "'\\x7fELF\\x02\\x01\\x01\\x00\\x00\\x1b]0;pwned\\x07\\xff\\xfe'")
+      << set.message();
+  EXPECT_TRUE(printable_ascii(set.message())) << set.message();
+  // A joint name is quoted from the file too.
+  Result<ClipSet> joint = parse_bvh("HIERARCHY\nROOT Hips\x1b[31m\xff\n{\n", "j.bvh");
+  ASSERT_FALSE(joint.ok());
+  EXPECT_NE(joint.message().find("joint 'Hips\\x1b[31m\\xff'"), std::string::npos)
+      << joint.message();
+  EXPECT_TRUE(printable_ascii(joint.message())) << joint.message();
+}
+
+TEST(BvhFixtures, DirectoryIsNotABvhFile) {
+  const std::string dir = test::scratch_dir("bvh_binary") + "/folder.bvh";
+  std::filesystem::create_directories(dir);
+  Result<ClipSet> set = load_bvh(dir);
+  ASSERT_FALSE(set.ok());
+  EXPECT_EQ(set.message(), dir + ": is a directory, expected a BVH file");
+}
+
+// Issue #12: analyze-clip on an empty folder printed nothing and exited 0.
+TEST(ClipLibrary, FolderWithoutClipsIsAnError) {
+  const std::string dir = test::scratch_dir("clip_library_empty");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/notes.txt") << "no clips here\n";
+  Result<std::vector<std::string>> paths = expand_clip_paths({dir});
+  ASSERT_FALSE(paths.ok());
+  EXPECT_EQ(paths.message(),
+            dir + ": the folder holds no clips (expected .bvh, .gltf or .glb files)");
 }
 
 }  // namespace

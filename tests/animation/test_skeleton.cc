@@ -225,7 +225,7 @@ TEST(SkeletonManifest, ErrorsNameFileAndField) {
       {R"({"roles": {"left_knee": 3}})", "m.json: roles.left_knee: expected a joint name"},
       {R"({"roles": ["left_knee"]})", "m.json: roles: expected an object"},
       {R"({"joints": {}})", "m.json: roles: missing"},
-      {R"({"roles": {"left_knee": )", "m.json: not valid JSON"},
+      {R"({"roles": {"left_knee": )", "m.json: invalid JSON: parse error"},
   };
   for (const auto& [text, expected] : cases) {
     Status st = apply_role_manifest_text(text, "m.json", &s);

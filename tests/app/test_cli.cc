@@ -1,10 +1,13 @@
 // The gaitkeeper executable end to end: analyze-clip over the real clips, bench reports, and the
 // METRICS.md rule that a metric recomputed from the --dump-joints CSV equals the JSON's.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -185,6 +188,150 @@ TEST(Cli, BadParametersAreRefusedWithTheirLimits) {
   r = run("bench --scenario corridor --frames 10 --clips /no/such/file.bvh");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("/no/such/file.bvh"), std::string::npos) << r.out;
+}
+
+// --- Issue #12: bad input ends in a message naming what was wrong, a non-zero exit, no crash. ---
+
+std::string write_file(const std::string& name, const std::string& bytes) {
+  const std::string path = test::scratch_dir("cli_bad_input") + "/" + name;
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+std::string make_dir(const std::string& name) {
+  const std::string dir = test::scratch_dir("cli_bad_input") + "/" + name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// No raw bytes of a binary input in what the program printed.
+bool printable_text(const std::string& s) {
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return (c >= 0x20 && c < 0x7F) || c == '\n' || c == '\r'; });
+}
+
+TEST(CliBadInput, ScenarioNumberTooLargeForADouble) {
+  const std::string s =
+      write_file("huge.json", "{\"name\": \"huge\", \"default_agents\": 1e400}\n");
+  const CommandResult r = run("bench --scenario " + s + " --frames 2");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(s + ": invalid JSON: number too large at line 1"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("terminate"), std::string::npos) << r.out;
+}
+
+TEST(CliBadInput, ParamsNumberTooLargeForADouble) {
+  const std::string p = write_file("huge_params.json", "{\"torsion_limit_deg\": 1e400}");
+  const CommandResult r = run("bench --scenario corridor --frames 2 --params " + p);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(p + ": invalid JSON: number too large"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("'1e400'"), std::string::npos) << r.out;
+}
+
+TEST(CliBadInput, ParamsNamingADirectory) {
+  const std::string dir = make_dir("params_dir");
+  const CommandResult r = run("bench --scenario corridor --frames 2 --params " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(dir + ": is a directory, expected a parameter file"), std::string::npos)
+      << r.out;
+}
+
+TEST(CliBadInput, TrajectoryNamingADirectory) {
+  const std::string dir = make_dir("tracks.txt");
+  const CommandResult r = run("bench --scenario " + dir + " --frames 2");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(dir + ": is a directory, expected a trajectory file"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("too large"), std::string::npos) << r.out;
+}
+
+TEST(CliBadInput, AnalyzeClipOnAFolderWithoutClips) {
+  const std::string dir = make_dir("no_clips");
+  const CommandResult r = run("analyze-clip " + dir);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find(dir + ": the folder holds no clips (expected .bvh, .gltf or .glb files)"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST(CliBadInput, TooManyAgentsAreRefusedBeforeTheSetup) {
+  const CommandResult r = run("bench --scenario corridor --frames 2 --agents 500000");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--agents: expected a number in [0, 250000], got '500000'"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("exceed max_agents"), std::string::npos) << "refused up front: " << r.out;
+  // A scenario whose own default is beyond the limit is refused the same way.
+  std::ifstream in(test::source_path("data/scenarios/corridor.json"));
+  std::string corridor((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = corridor.find("\"default_agents\": 60");
+  ASSERT_NE(at, std::string::npos);
+  corridor.replace(at, 20, "\"default_agents\": 300000");
+  const std::string big = write_file("big_default.json", corridor);
+  const CommandResult d = run("bench --scenario " + big + " --frames 2");
+  EXPECT_EQ(d.code, 2) << d.out;
+  EXPECT_NE(d.out.find("default_agents 300000 exceeds the limit of 250000 agents"),
+            std::string::npos)
+      << d.out;
+}
+
+TEST(CliBadInput, OutputPathsAreCheckedBeforeTheWork) {
+  // 100,000 frames would run for minutes: the error must come first.
+  CommandResult r = run("bench --scenario corridor --frames 100000 --json /nonexistent/r.json");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--json /nonexistent/r.json: the folder /nonexistent does not exist"),
+            std::string::npos)
+      << r.out;
+  r = run("bench --scenario corridor --frames 100000 --dump-joints /nonexistent/j.csv");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--dump-joints /nonexistent/j.csv: the folder /nonexistent does not exist"),
+            std::string::npos)
+      << r.out;
+  const std::string dir = make_dir("json_is_a_dir");
+  r = run("bench --scenario corridor --frames 100000 --json " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--json " + dir + ": is a directory, expected a file name"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST(CliBadInput, BinaryFilesAreNotEchoed) {
+  static constexpr char kBytes[] =
+      "\x7f"
+      "ELF\x02\x01\x01\x00\x1b[2J\x1b]0;x\x07\xff\xfe 1 2 3\n";
+  const std::string bytes(kBytes, sizeof(kBytes) - 1);
+  const std::string bvh = write_file("binary.bvh", bytes);
+  CommandResult r = run("analyze-clip " + bvh);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find(bvh + ":1: expected 'HIERARCHY', found '\\x7fELF"), std::string::npos)
+      << r.out;
+  EXPECT_TRUE(printable_text(r.out)) << r.out;
+  const std::string txt = write_file("binary.txt", bytes);
+  r = run("bench --frames 2 --scenario " + txt);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(txt + ":1: column 1 (frame): expected a number, found '\\x7fELF"),
+            std::string::npos)
+      << r.out;
+  EXPECT_TRUE(printable_text(r.out)) << r.out;
+  const std::string json = write_file("binary.json", bytes);
+  r = run("bench --frames 2 --scenario " + json);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(json + ": invalid JSON: parse error at line 1"), std::string::npos) << r.out;
+  EXPECT_TRUE(printable_text(r.out)) << r.out;
+}
+
+// --frames keeps its limit of 10,000,000; such a run must start and keep running (it reserved
+// agents x frames metric samples up front: 40 GB for 1,000 agents, std::bad_alloc). `timeout`
+// ends it: exit 124.
+TEST(CliBadInput, LongestRunStartsWithoutCrashing) {
+  const CommandResult r = test::run_gaitkeeper(
+      "bench --scenario corridor --agents 1000 --frames 10000000", "timeout 8 ");
+  EXPECT_EQ(r.code, 124) << r.out;
+  const CommandResult over = run("bench --scenario corridor --frames 10000001");
+  EXPECT_EQ(over.code, 2) << over.out;
+  EXPECT_NE(over.out.find("--frames: expected a number in [1, 10000000]"), std::string::npos)
+      << over.out;
 }
 
 }  // namespace

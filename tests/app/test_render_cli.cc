@@ -140,6 +140,58 @@ TEST(RenderCli, BadOptionsAreNamed) {
   EXPECT_EQ(r.code, 2);
 }
 
+// Issue #12: an unwritable output used to fail only after the whole simulation. These checks
+// come before the GL context, so they run without one.
+TEST(RenderCli, OutputPathsAreCheckedBeforeTheWork) {
+  test::CommandResult r = test::run_gaitkeeper("render --frames 100000 --out /nonexistent/x.png");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--out /nonexistent/x.png: the folder /nonexistent does not exist"),
+            std::string::npos)
+      << r.out;
+  r = test::run_gaitkeeper("render --frames 100000 --out /nonexistent/x.mp4");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("the folder /nonexistent does not exist"), std::string::npos) << r.out;
+  const std::string dir = test::scratch_dir("render_bad_out");
+  r = test::run_gaitkeeper("render --frames 100000 --out " + dir +
+                           "/x.png --report /nonexistent/r.json");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--report /nonexistent/r.json: the folder /nonexistent does not exist"),
+            std::string::npos)
+      << r.out;
+  const std::string file = dir + "/plain_file";
+  std::ofstream(file) << "x";
+  r = test::run_gaitkeeper("render --frames 100000 --out " + file + "/frames");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(file + " is not a folder"), std::string::npos) << r.out;
+}
+
+// Issue #12: --follow of an id no agent has was silently ignored.
+TEST(RenderCli, FollowOfAnUnknownAgentIsAnError) {
+  test::CommandResult r = test::run_gaitkeeper(
+      "render --scenario crossing --agents 24 --frames 2 --follow 999999 --out /tmp/gk_f.png");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--follow 999999: no agent with that id; expected an id in [0, 23] "
+                       "(crossing has 24 agents)"),
+            std::string::npos)
+      << r.out;
+  const std::string tracks = test::scratch_dir("render_follow") + "/tracks.txt";
+  std::ofstream(tracks) << "0 5 0 0\n10 5 1 0\n0 9 2 0\n10 9 3 0\n";
+  r = test::run_gaitkeeper("render --scenario " + tracks +
+                           " --frames 2 --follow 6 --out /tmp/gk_f.png");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--follow 6: no pedestrian with that id in " + tracks +
+                       " (its 2 pedestrian ids run from 5 to 9)"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST(RenderCli, FollowOfAKnownAgentRenders) {
+  const std::string out = test::scratch_dir("render_follow") + "/follow.png";
+  GK_RUN_RENDER(r, "render --scenario crossing --agents 6 --frames 3 --follow 5 " +
+                       std::string(kCamera) + " --out " + out);
+  EXPECT_TRUE(std::filesystem::exists(out));
+}
+
 TEST(RenderCli, NoGlContextIsAMessageNotACrash) {
   // GLVND with no vendor library finds no EGL implementation at all.
   const test::CommandResult r =

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -282,6 +283,45 @@ TEST(TrajectoryReplay, MalformedFilesNameFileAndLine) {
   r = load_trajectory_replay(test::scratch_dir("replay") + "/does_not_exist.txt");
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.message().find("does_not_exist.txt: cannot open"), std::string::npos);
+}
+
+// True when every byte is printable ASCII or a newline: no raw file bytes reached the message.
+bool printable_ascii(const std::string& s) {
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return (c >= 0x20 && c < 0x7F) || c == '\n'; });
+}
+
+// Issue #12: a folder named like a trajectory file was reported as "file too large
+// (9223372036854775807 bytes)".
+TEST(TrajectoryReplay, DirectoryIsNamedAsADirectory) {
+  const std::string dir = test::scratch_dir("replay") + "/folder.txt";
+  std::filesystem::create_directories(dir);
+  Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(dir);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.message(), dir + ": is a directory, expected a trajectory file");
+}
+
+// Issue #12: a binary file's bytes were echoed raw into "expected a number, found '...'".
+TEST(TrajectoryReplay, BinaryFileBytesAreEscapedInTheMessage) {
+  static constexpr char kBytes[] =
+      "0 1 \x7f"
+      "ELF\x01\x1b[31m\xff\xfe\x00z 2\n";
+  const std::string bin = write_scratch("binary.txt", std::string(kBytes, sizeof(kBytes) - 1));
+  Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(bin);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.message().rfind(bin + ":1: column 3 (x): expected a number, found ", 0), 0u)
+      << r.message();
+  EXPECT_NE(r.message().find(R"('\x7fELF\x01\x1b[31m\xff\xfe\x00z')"), std::string::npos)
+      << r.message();
+  EXPECT_TRUE(printable_ascii(r.message())) << r.message();
+}
+
+TEST(TrajectoryReplay, ReportsThePedestrianIdsOfTheFile) {
+  const std::string path = write_scratch("ids.txt", "0 7 0 0\n10 7 1 0\n10 3 0 1\n20 3 1 1\n");
+  std::vector<uint32_t> ids;
+  Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(path, {}, &ids);
+  ASSERT_TRUE(r.ok()) << r.message();
+  EXPECT_EQ(ids, (std::vector<uint32_t>{3, 7}));
 }
 
 TEST(TrajectoryReplay, RejectsBadFrameTimeAndSteps) {

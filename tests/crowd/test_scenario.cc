@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 #include <vector>
@@ -206,6 +207,27 @@ TEST(Scenario, MissingFileAndUnknownName) {
   // A path is loaded as a path, whatever the folder.
   auto by_path = load_scenario_by_name(scenarios() + "/circle.json", "/nonexistent");
   EXPECT_TRUE(by_path.ok()) << by_path.message();
+}
+
+// Issue #12: nlohmann reports a number beyond a double as out_of_range, not parse_error; it must
+// be an error naming the file and line, not std::terminate.
+TEST(Scenario, NumberTooLargeForADoubleNamesFileAndLine) {
+  const std::string path = test::scratch_dir("scenario_bad") + "/huge.json";
+  std::ofstream(path) << "{\n  \"name\": \"huge\",\n  \"default_agents\": 1e400\n}\n";
+  auto s = load_scenario(path);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().rfind(path + ": invalid JSON: number too large at line 3", 0), 0u)
+      << s.message();
+  EXPECT_NE(s.message().find("'1e400'"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("range of a double"), std::string::npos) << s.message();
+}
+
+TEST(Scenario, DirectoryIsNotAScenarioFile) {
+  const std::string dir = test::scratch_dir("scenario_bad") + "/folder.json";
+  std::filesystem::create_directories(dir);
+  auto s = load_scenario(dir);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message(), dir + ": is a directory, expected a scenario file");
 }
 
 TEST(Scenario, EnvironmentOverridesScenarioDir) {

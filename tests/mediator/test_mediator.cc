@@ -2,6 +2,8 @@
 // limit, facing, feedback and robustness, each measured with the METRICS.md definitions.
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -236,6 +238,32 @@ TEST(Mediator, AgentsComeAndGo) {
       EXPECT_NEAR(root.x, p[i].x, 0.1f);
     }
   }
+}
+
+// Issue #12: a parameter file must fail with a message, whatever is wrong with it.
+TEST(MediatorParams, JsonNumberTooLargeNamesFileAndLine) {
+  const std::string path = test::scratch_dir("params") + "/huge.json";
+  std::ofstream(path) << "{\n  \"torsion_limit_deg\": 1e400\n}\n";
+  MediatorParams p;
+  const Status s = load_mediator_params_json(path, &p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().rfind(path + ": invalid JSON: number too large at line 2", 0), 0u)
+      << s.message();
+  EXPECT_NE(s.message().find("'1e400'"), std::string::npos) << s.message();
+  EXPECT_EQ(p.torsion_limit_deg, MediatorParams{}.torsion_limit_deg);
+}
+
+TEST(MediatorParams, DirectoryIsNotAParameterFile) {
+  const std::string dir = test::scratch_dir("params") + "/folder.json";
+  std::filesystem::create_directories(dir);
+  MediatorParams p;
+  const Status s = load_mediator_params_json(dir, &p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message(), dir + ": is a directory, expected a parameter file");
+  const Status missing = load_mediator_params_json(dir + "/none.json", &p);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.message().find("none.json: cannot open the parameter file"), std::string::npos)
+      << missing.message();
 }
 
 }  // namespace
