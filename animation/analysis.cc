@@ -132,13 +132,19 @@ std::vector<TimeInterval> to_intervals(const std::vector<uint8_t>& c, float fps,
 }
 
 // Phase markers: left contact starts at 0, right contact starts at 0.5; piecewise linear between.
-std::vector<float> gait_phase(const ClipAnalysis& a, float period_s) {
+std::vector<float> gait_phase(const ClipAnalysis& a, float period_s, bool loops) {
   struct Marker {
     float t, phase;
   };
   std::vector<Marker> m;
-  for (const TimeInterval& c : a.contacts[0]) m.push_back({c.start_s, 0.0f});
-  for (const TimeInterval& c : a.contacts[1]) m.push_back({c.start_s, 0.5f});
+  // A contact cut by a take's first frame did not start there: it marks no phase.
+  const float first = loops ? -1.0f : 0.5f / a.fps;
+  for (const TimeInterval& c : a.contacts[0]) {
+    if (c.start_s > first) m.push_back({c.start_s, 0.0f});
+  }
+  for (const TimeInterval& c : a.contacts[1]) {
+    if (c.start_s > first) m.push_back({c.start_s, 0.5f});
+  }
   std::sort(m.begin(), m.end(), [](const Marker& x, const Marker& y) { return x.t < y.t; });
   std::vector<float> phase(a.num_frames, 0.0f);
   if (m.empty() || period_s <= 0.0f) return phase;
@@ -339,7 +345,7 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
     }
   }
   if (clip.loops && a.contacts[0].size() >= 2) period = a.duration_s / a.contacts[0].size();
-  a.phase = gait_phase(a, period);
+  a.phase = gait_phase(a, period, clip.loops);
 
   // Floor: the clip played at 60 Hz with its own root motion (in-place clips with the inferred
   // travel velocity added), measured with the METRICS.md contact definition.

@@ -11,6 +11,9 @@
 namespace gk {
 namespace {
 
+// Share of a re-planting step spent lifting the foot before it moves (and setting it down after).
+constexpr float kStepLift = 0.2f;
+
 // 0 -> 1 with zero slope at both ends.
 float smoothstep01(float x) {
   x = std::clamp(x, 0.0f, 1.0f);
@@ -125,14 +128,16 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
     case FootLockState::kLocked:
       return pinned_goal() + lock.offset;
     case FootLockState::kStepping: {
-      // Lifted and carried to where the clip has the foot, with zero speed at both ends (no snap);
-      // as high as the clips' own swing.
+      // Lifted, carried and set down where the clip has the foot, as high as the clips' own
+      // swing: the foot rises before it moves and stops moving before it lands (zero speed at
+      // both ends, so nothing snaps).
       lock.timer_s += dt;
       const float u = std::min(1.0f, lock.timer_s / p.step_time_s);
       const float s = std::sin(std::numbers::pi_v<float> * u);
       const glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
-      glm::vec3 goal = glm::mix(lock.from, to, smoothstep01(u));
-      goal.y += p.step_height_m * s * s;
+      glm::vec3 goal =
+          glm::mix(lock.from, to, smoothstep01((u - kStepLift) / (1.0f - 2.0f * kStepLift)));
+      goal.y = glm::mix(lock.from.y, to.y, smoothstep01(u)) + p.step_height_m * s * s;
       if (u >= 1.0f) {
         lock.state = FootLockState::kLocked;
         lock.target = to;

@@ -359,6 +359,48 @@ std::vector<std::string> LocomotionLibrary::clip_names() const {
   return names;
 }
 
+std::vector<int> retarget_joint_map(const Skeleton& src, const Skeleton& dst) {
+  const int nd = dst.num_joints(), ns = src.num_joints();
+  std::vector<int> map(nd, -1);
+  std::vector<uint8_t> used(ns, 0);
+  auto take = [&](int d, int s) {
+    if (d < 0 || s < 0 || map[d] >= 0 || used[s]) return;
+    map[d] = s;
+    used[s] = 1;
+  };
+  // Roles first (they hold whatever the naming convention), then equal names.
+  for (int r = 0; r < kNumJointRoles; ++r) {
+    take(dst.role(static_cast<JointRole>(r)), src.role(static_cast<JointRole>(r)));
+  }
+  for (int d = 0; d < nd; ++d) take(d, src.find(dst.names[d]));
+  // Then down unmapped chains from mapped joints (elbows and wrists below the shoulders, a neck
+  // between chest and head): the child with the most descendants on each side.
+  auto descendants = [](const Skeleton& sk) {
+    std::vector<int> n(sk.num_joints(), 0);
+    for (int j = sk.num_joints() - 1; j > 0; --j) {
+      if (sk.parents[j] >= 0) n[sk.parents[j]] += n[j] + 1;
+    }
+    return n;
+  };
+  const std::vector<int> dn = descendants(dst), sn = descendants(src);
+  for (int d = 0; d < nd; ++d) {  // parents come before children: chains extend in one pass
+    if (map[d] < 0) continue;
+    int best_d = -1, best_s = -1;
+    for (int c = 0; c < nd; ++c) {
+      if (dst.parents[c] == d && map[c] < 0 && (best_d < 0 || dn[c] > dn[best_d])) best_d = c;
+    }
+    for (int c = 0; c < ns; ++c) {
+      if (src.parents[c] == map[d] && !used[c] && (best_s < 0 || sn[c] > sn[best_s])) best_s = c;
+    }
+    // Only where each side has a single way down (a hand's five fingers stay at rest).
+    int kids_d = 0, kids_s = 0;
+    for (int c = 0; c < nd; ++c) kids_d += dst.parents[c] == d && map[c] < 0;
+    for (int c = 0; c < ns; ++c) kids_s += src.parents[c] == map[d] && !used[c];
+    if (kids_d == 1 && kids_s == 1) take(best_d, best_s);
+  }
+  return map;
+}
+
 Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, float root_scale) {
   Clip out;
   out.name = clip.name;
@@ -367,22 +409,52 @@ Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, f
   out.num_frames = clip.num_frames;
   out.num_joints = dst.num_joints();
   out.loops = clip.loops;
-  std::vector<int> map(dst.num_joints());
-  for (int j = 0; j < dst.num_joints(); ++j) map[j] = src.find(dst.names[j]);
-  out.rotations.resize(static_cast<size_t>(out.num_frames) * out.num_joints);
+  const int nd = dst.num_joints();
+  const std::vector<int> map = retarget_joint_map(src, dst);
+  // Rest-pose aware: a mapped joint takes the source joint's model-space rotation relative to the
+  // source rest pose, applied to the destination rest pose (skeletons whose joint frames differ
+  // still bend alike); unmapped joints keep their rest rotation under their parent.
+  const std::vector<glm::mat4> src_rest = rest_model(src), dst_rest = rest_model(dst);
+  std::vector<glm::quat> src_rest_inv(src.num_joints()), dst_rest_rot(nd);
+  for (int j = 0; j < src.num_joints(); ++j) {
+    src_rest_inv[j] = glm::inverse(glm::normalize(glm::quat_cast(glm::mat3(src_rest[j]))));
+  }
+  for (int j = 0; j < nd; ++j)
+    dst_rest_rot[j] = glm::normalize(glm::quat_cast(glm::mat3(dst_rest[j])));
+  const int src_hips = src.role(JointRole::kHips), dst_hips = dst.role(JointRole::kHips);
+  out.rotations.resize(static_cast<size_t>(out.num_frames) * nd);
   out.translations.resize(out.rotations.size());
+  std::vector<glm::mat4> model(src.num_joints());
+  std::vector<glm::quat> dst_model(nd);
   for (int f = 0; f < clip.num_frames; ++f) {
-    for (int j = 0; j < dst.num_joints(); ++j) {
-      const size_t o = static_cast<size_t>(f) * out.num_joints + j;
+    frame_model(clip, src, f, model);
+    for (int j = 0; j < nd; ++j) {
+      const size_t o = static_cast<size_t>(f) * nd + j;
+      const int parent = dst.parents[j];
       const int s = map[j];
-      if (s < 0) {
-        out.rotations[o] = dst.rest_rotations[j];
-        out.translations[o] = dst.rest_translations[j];
-        continue;
+      if (s >= 0) {
+        const glm::quat src_rot = glm::normalize(glm::quat_cast(glm::mat3(model[s])));
+        dst_model[j] = glm::normalize(src_rot * src_rest_inv[s] * dst_rest_rot[j]);
+      } else {
+        dst_model[j] =
+            (parent < 0 ? glm::quat(1, 0, 0, 0) : dst_model[parent]) * dst.rest_rotations[j];
       }
-      out.rotations[o] = clip.frame_rotations(f)[s];
-      out.translations[o] = dst.parents[j] < 0 ? clip.frame_translations(f)[s] * root_scale
-                                               : dst.rest_translations[j];
+      out.rotations[o] = parent < 0
+                             ? dst_model[j]
+                             : glm::normalize(glm::inverse(dst_model[parent]) * dst_model[j]);
+      out.translations[o] = dst.rest_translations[j];
+    }
+    // The root travels as the source hips do, scaled by the ratio of leg lengths (an extra root
+    // above the hips on either side is carried along).
+    const size_t root = static_cast<size_t>(f) * nd;
+    if (src_hips >= 0 && dst_hips >= 0) {
+      const glm::vec3 hips = translation_of(model[src_hips]) * root_scale;
+      // Root -> hips offset in the root's frame (rest pose of any joints in between).
+      const glm::vec3 chain = glm::inverse(dst_rest_rot[0]) *
+                              (translation_of(dst_rest[dst_hips]) - translation_of(dst_rest[0]));
+      out.translations[root] = hips - dst_model[0] * chain;
+    } else if (map[0] >= 0) {
+      out.translations[root] = clip.frame_translations(f)[map[0]] * root_scale;
     }
   }
   return out;

@@ -81,11 +81,17 @@ struct LocomotionLibrary {
 };
 
 // Builds the library from one or more clip sets. The first set's skeleton is the library skeleton;
-// clips of other sets are retargeted to it by joint name (rotations copied, root translation scaled
-// by the ratio of leg lengths). Errors name the set and what is missing.
+// clips of other sets are retargeted to it (retarget_clip). Errors name the set and what is
+// missing.
 Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& sets);
 
-// Retargets a clip by joint names onto `dst`; `root_scale` scales the root joint's translation.
+// Which source joint drives each destination joint (-1: none): by joint role (whatever the naming
+// convention), then by equal name, then down single chains from mapped joints (elbows, wrists).
+std::vector<int> retarget_joint_map(const Skeleton& src, const Skeleton& dst);
+
+// Retargets a clip onto `dst` through retarget_joint_map, rest-pose aware (model-space rotations
+// relative to each skeleton's rest pose); the hips travel as the source hips, scaled by
+// `root_scale` (the ratio of leg lengths).
 Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, float root_scale);
 
 }  // namespace gk

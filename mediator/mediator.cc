@@ -389,9 +389,18 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     const int nf = clip.clip.num_frames;
     int f = static_cast<int>(std::lround(lt[k] * clip.clip.fps));
     f = clip.clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
+    // Toe heights between frames (a 24 or 30 fps clip must not step the foot every other frame).
+    const float ft = lt[k] * clip.clip.fps;
+    const int f0 = static_cast<int>(std::floor(ft));
+    const float fu = ft - static_cast<float>(f0);
+    auto wrap = [&](int i) {
+      return clip.clip.loops ? ((i % nf) + nf) % nf : std::clamp(i, 0, nf - 1);
+    };
     for (int s = 0; s < 2; ++s) {
       if (clip.gait && !clip.toe_height_m[s].empty()) {
-        toe_gait[s] += lw[k] * (clip.toe_height_m[s][f] + clip.toe_floor_m[s]);
+        const auto& h = clip.toe_height_m[s];
+        const float hv = h[wrap(f0)] + fu * (h[wrap(f0 + 1)] - h[wrap(f0)]);
+        toe_gait[s] += lw[k] * (hv + clip.toe_floor_m[s]);
       }
     }
     if (gait_votes && !clip.gait) continue;

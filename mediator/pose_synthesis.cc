@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -39,6 +41,16 @@ constexpr float kMaxHeelOff =
     1.0f;  // [rad] about 57 deg, a stance foot's plantarflexion at toe-off
 
 constexpr float kHeelHalflife = 0.05f;  // [s] a raised heel settles back this fast
+
+// The foot's pitch about its toe [rad] that lifts an ankle at toe + d to ankle_floor (0 when it is
+// already as high): the heel rises, the ball stays.
+float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle_floor) {
+  const float len = glm::length(d);
+  if (len < 1e-6f || toe.y + d.y >= ankle_floor) return 0.0f;
+  const float now = std::asin(std::clamp(d.y / len, -1.0f, 1.0f));
+  const float want = std::asin(std::clamp((ankle_floor - toe.y) / len, -1.0f, 1.0f));
+  return std::clamp(want - now, 0.0f, kMaxHeelOff);
+}
 
 // Returns the pitch [rad].
 float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
@@ -107,6 +119,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   });
   first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
   first_spine_joint_ = skeleton_.spine_chain.empty() ? num_joints_ : skeleton_.spine_chain.front();
+  dbg_ = std::getenv("GK_DBG2") != nullptr;  // TEMP
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -184,6 +197,14 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   for (int side = 0; side < 2; ++side) {
     locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
         translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+  }
+  if (dbg_) {
+    const size_t k = static_cast<size_t>(slot) * 2;
+    const glm::vec3 t0 = locks_.drawn_toe[k], t1 = locks_.drawn_toe[k + 1];
+    std::fprintf(stderr, "E %d %d %d %.2f %.2f %.2f %.2f %d %.5f %.5f %.5f %.5f %.5f %.5f %.3f\n",
+                 slot, (int)locks_.lock[k].state, (int)locks_.lock[k + 1].state, pl.plant[0][slot],
+                 pl.plant[1][slot], pl.hold[0][slot], pl.hold[1][slot], (int)pl.standing[slot],
+                 t0.x, t0.y, t0.z, t1.x, t1.y, t1.z, pl.speed_m_s[slot]);
   }
   if (!(apm && P.foot_locking)) {
     for (int side = 0; side < 2; ++side) {
@@ -291,14 +312,13 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     glm::vec3 g = goal[side];
     const glm::vec3 drawn_ankle = translation_of(world_[base + ankle]);
     const glm::vec3 drawn_toe = translation_of(world_[base + skeleton_.toe(sd)]);
-    // Never below the floor the clips were authored on: the whole foot is raised as far as its
-    // deeper joint needs.
-    const glm::vec3 ankle_goal = drawn_ankle + (g - drawn_toe);
-    const float raise = std::max(
-        {0.0f, library_.planted_toe_m[side] - g.y, library_.planted_ankle_m[side] - ankle_goal.y});
-    g.y += raise;
+    // Never below the floor the clips were authored on: a toe below it is raised onto it, and an
+    // ankle below its own floor lifts the heel about the ball (below, with the heel-off pivot).
+    g.y = std::max(g.y, library_.planted_toe_m[side]);
     toe_offset[side] = g - drawn_toe;
-    use_ik[side] = glm::dot(toe_offset[side], toe_offset[side]) > 1e-10f;
+    use_ik[side] = glm::dot(toe_offset[side], toe_offset[side]) > 1e-10f ||
+                   drawn_ankle.y + toe_offset[side].y < library_.planted_ankle_m[side] ||
+                   locks_.heel_pitch[static_cast<size_t>(slot) * 2 + side] > 0.0f;
     ankle_world_rot[side] = rotation_of(world_[base + ankle]);
   }
   if (!use_ik[0] && !use_ik[1]) return;
@@ -331,6 +351,7 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
           locks_.lock[k].state == FootLockState::kLocked) {
         wanted = heel_off_pivot(toe_goal, goal_ankle, hip_p, limit);
       }
+      wanted = std::max(wanted, heel_to_floor(toe_goal, d, library_.planted_ankle_m[side]));
     }
     if (wanted >= pitch) {
       pitch = wanted;

@@ -121,13 +121,16 @@ TEST(Analysis, PhaseIsZeroAtLeftContactsAndIncreases) {
   const Loaded l = load_and_analyze("clips/bvh/cmu_07_01_walk.bvh");
   const ClipAnalysis& a = l.analysis;
   ASSERT_EQ(a.phase.size(), static_cast<size_t>(a.num_frames));
+  // A contact already under way on the take's first frame starts no step.
   for (const TimeInterval& c : a.contacts[0]) {
     const int f = static_cast<int>(std::lround(c.start_s * a.fps));
+    if (f == 0) continue;
     const float p = a.phase[f];
     EXPECT_LT(std::min(p, 1.0f - p), 0.01f) << "left contact at " << c.start_s;
   }
   for (const TimeInterval& c : a.contacts[1]) {
     const int f = static_cast<int>(std::lround(c.start_s * a.fps));
+    if (f == 0) continue;
     EXPECT_NEAR(a.phase[f], 0.5f, 0.01f) << "right contact at " << c.start_s;
   }
   int backward = 0;
