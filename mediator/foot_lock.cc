@@ -33,7 +33,7 @@ void release_foot_lock(FootLock& lock, const glm::vec3& drawn_toe, const glm::ve
   lock.from = drawn_toe;
   lock.offset = drawn_toe - anim_toe;
   lock.offset_vel = drawn_vel - anim_vel;
-  lock.shed = 0.0f;
+  lock.shed = lock.shed_from = lock.shed_goal = lock.released_s = 0.0f;
   lock.swing_from = -1.0f;  // taken from the first frame's progress
 }
 
@@ -50,10 +50,12 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
   const glm::vec3 anim_vel = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
   auto lock_here = [&](const glm::vec3& at) {
     lock.state = FootLockState::kLocked;
-    lock.target = glm::vec3(at.x, std::max(in.floor_toe_m, in.anim_toe.y), at.z);
-    // Vertically the foot settles (it may still be coming down); horizontally it stops.
+    // Pinned no higher than it is drawn (a pinned toe never rises) nor than the clip has it, and
+    // never below the floor; a foot drawn above that settles down onto it.
     const float drawn_y = in.fresh ? in.anim_toe.y : in.drawn_toe_prev.y;
-    lock.offset = glm::vec3(0.0f, drawn_y - std::max(in.floor_toe_m, in.anim_toe.y), 0.0f);
+    const float y = std::max(in.floor_toe_m, std::min(drawn_y, in.anim_toe.y));
+    lock.target = glm::vec3(at.x, y, at.z);
+    lock.offset = glm::vec3(0.0f, std::max(0.0f, drawn_y - y), 0.0f);
     lock.offset_vel = glm::vec3(0.0f);
   };
   // Where the toe is drawn while pinned: it follows the clip's toe down onto the floor as the foot
@@ -88,10 +90,7 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
     case FootLockState::kStepping:
       // The clips lift the foot before the step is done: it joins their swing from where it is,
       // at the speed it has.
-      if (!in.hold) {
-        release_foot_lock(lock, lock.last_goal, (lock.last_goal - in.drawn_toe_prev) / dt,
-                          in.anim_toe, anim_vel);
-      }
+      if (!in.hold) release_foot_lock(lock, lock.last_goal, lock.goal_vel, in.anim_toe, anim_vel);
       break;
   }
 
@@ -102,16 +101,23 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
     case FootLockState::kFree:
       return in.anim_toe + lock.offset;
     case FootLockState::kReleasing: {
-      if (lock.swing_from < 0.0f) lock.swing_from = std::min(in.swing_progress, 0.9f);
-      // A progress that went back means the clips started a new swing: the old one is over.
-      const float span = 1.0f - lock.swing_from;
-      const float u = in.swing_progress + 0.05f < lock.swing_from
-                          ? 1.0f
-                          : (in.swing_progress - lock.swing_from) / span;
-      lock.shed = std::max(lock.shed, smoothstep01(u));
+      // Shed in the swing's progress from where the release began (a progress that went back,
+      // as when the blend changes clips, restarts the count from there: never a jump).
+      if (lock.swing_from < 0.0f || in.swing_progress + 0.05f < lock.swing_from) {
+        lock.swing_from = std::min(in.swing_progress, 0.9f);
+        lock.shed_from = lock.shed_goal;
+      }
+      const float u = (in.swing_progress - lock.swing_from) / (1.0f - lock.swing_from);
+      lock.shed_goal =
+          std::max(lock.shed_goal, lock.shed_from + (1.0f - lock.shed_from) * smoothstep01(u));
+      // A release late in the swing still takes its time (twice the halflife at least), not a
+      // frame or two; it may then land before the offset is gone, and is pinned where it is.
+      lock.released_s += dt;
+      const float by_time = smoothstep01(lock.released_s / (2.0f * p.release_halflife_s));
+      lock.shed = std::max(lock.shed, std::min(lock.shed_goal, by_time));
       // Upward the foot follows the clip's lift at once (a spring, so the knee does not snap);
       // sideways it is corrected over the swing.
-      if (lock.offset.y < 0.0f || lock.offset_vel.y != 0.0f) {
+      {
         float y = lock.offset.y, vy = lock.offset_vel.y;
         critical_spring(y, vy, 0.0f, 0.5f * p.release_halflife_s, dt);
         lock.offset.y = y;
@@ -156,8 +162,10 @@ glm::vec3 step_foot_lock(FootLock& lock, const FootLockInput& in, const FootLock
     lock = FootLock();
     lock.last_goal = in.anim_toe;
   }
-  lock.last_goal = advance(lock, in, p, dt);
-  return lock.last_goal;
+  const glm::vec3 goal = advance(lock, in, p, dt);
+  lock.goal_vel = in.fresh ? glm::vec3(0.0f) : (goal - lock.last_goal) / dt;
+  lock.last_goal = goal;
+  return goal;
 }
 
 }  // namespace gk

@@ -27,9 +27,13 @@ struct FootLock {
   glm::vec3 offset_vel{0.0f};  // its rate [m/s]
   glm::vec3 from{0.0f};        // stepping: where the step started [m]
   float timer_s = 0.0f;        // stepping: time since the step started [s]
-  glm::vec3 last_goal{0.0f};   // the goal returned last frame [m] (for the drawn foot's speed)
+  glm::vec3 last_goal{0.0f};   // the goal returned last frame [m]
+  glm::vec3 goal_vel{0.0f};    // its velocity [m/s] (a step turned release keeps its speed)
   float shed = 0.0f;           // releasing: share of the release offset shed so far, 0..1
   float swing_from = 0.0f;     // releasing: the swing progress at release
+  float shed_from = 0.0f;      // releasing: share shed when that progress was taken
+  float shed_goal = 0.0f;      // releasing: share the swing's progress asks for
+  float released_s = 0.0f;     // releasing: time since the release [s]
 };
 
 struct FootLockInput {

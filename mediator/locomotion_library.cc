@@ -495,6 +495,14 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       lc.speed_m_s = lc.analysis.native_speed_m_s;
       lc.direction_rad = lc.analysis.direction_rad;
       lc.clip = make_in_place(clip, sk, lc.analysis, facing);
+      if (!lc.analysis.in_place) {
+        // The take as captured (root motion kept), on a level floor: the metrics' references.
+        lc.source = clip;
+        for (int f = 0; f < lc.source.num_frames; ++f) {
+          lc.source.translations[static_cast<size_t>(f) * lc.source.num_joints].y -=
+              lc.analysis.ground_slope_m_s * (f / lc.source.fps);
+        }
+      }
       fill_contacts_and_heights(&lc, sk);
       const bool both_feet = !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
       if (lc.speed_m_s < kMinGaitSpeed) {

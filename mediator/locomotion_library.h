@@ -18,7 +18,10 @@ namespace gk {
 inline constexpr int kPhaseTableSize = 64;
 
 struct LocomotionClip {
-  Clip clip;                   // in place, facing +z, on the library skeleton
+  Clip clip;  // in place, facing +z, on the library skeleton
+  // The take as captured, with its root motion, on the library skeleton and floor (empty for a
+  // clip authored in place): what the metrics' clip references and floors play.
+  Clip source;
   ClipAnalysis analysis;       // of the original (retargeted) clip
   float speed_m_s = 0.0f;      // native ground speed
   float direction_rad = 0.0f;  // travel direction relative to facing (0 forward, +pi/2 left)

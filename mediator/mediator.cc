@@ -56,6 +56,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   seen_.assign(capacity, 0);
   to_erase_.reserve(capacity);
   plans_.slot_of_agent.assign(capacity, -1);
+  plans_.gait_weight.assign(capacity, 0.0f);
   plans_.agent_of_slot.assign(capacity, -1);
   plans_.layer_clip.assign(L, 0);
   plans_.layer_weight.assign(L, 0.0f);
@@ -459,11 +460,12 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   pl.travel_yaw[slot] = wrap_pi(psi + (gait_w > 0.0f ? std::atan2(dir_sum.x, dir_sum.y) : 0.0f));
   pl.playback_rate[slot] = gait_w > 0.0f ? rate : 1.0f;
   pl.speed_m_s[slot] = speed;
+  pl.gait_weight[slot] = gait_w;
   for (int s = 0; s < 2; ++s) {
     pl.plant[s][slot] = plant[s];
     pl.hold[s][slot] = hold[s];
     pl.swing_progress[s][slot] = swing[s] / std::max(vote_w, 1e-6f);
-    pl.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : -1e9f;
+    pl.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : 0.0f;
   }
   pl.phase[slot] = phase_[slot];
   pl.blend_progress[slot] = fade_[slot];

@@ -43,6 +43,7 @@ struct AnimationPlans {
   // blended with a standing pose swings lower, and pose synthesis gives a foot that is not pinned
   // the gait clips' own swing height back.
   std::vector<float> gait_toe_y[2];
+  std::vector<float> gait_weight;        // share of gait clips (not standing) in the blend, 0..1
   std::vector<float> swing_progress[2];  // blended swing progress of each foot, 0..1
   std::vector<float> phase;              // gait phase [0, 1)
   std::vector<float> blend_progress;     // b: 0 when the chosen clips just changed, 1 when settled

@@ -255,10 +255,13 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
   bool pinned[2] = {false, false};
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
-    // The clip's toe, no lower than the gait clips alone have it (a blend with a standing pose
-    // swings lower).
+    // The clip's toe, no lower than the gait clips alone have it (a walk blended with a standing
+    // pose swings lower); the more the blend stands, the less of that height is given back, so
+    // it fades in and out with the blend.
     anim_toe[side] = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
-    anim_toe[side].y = std::max(anim_toe[side].y, pl.gait_toe_y[side][slot] + root[3].y);
+    const float lost = pl.gait_toe_y[side][slot] + root[3].y - anim_toe[side].y;
+    const float walking = std::clamp(2.0f * pl.gait_weight[slot], 0.0f, 1.0f);
+    anim_toe[side].y += std::max(0.0f, lost) * walking * walking * (3.0f - 2.0f * walking);
     FootLockInput in;
     in.anim_toe = anim_toe[side];
     in.anim_toe_prev = locks_.anim_toe[k];

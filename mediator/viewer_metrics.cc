@@ -52,16 +52,19 @@ PlayedClip play_with_root_motion(const LocomotionClip& lc, const Skeleton& sk, f
   std::vector<glm::quat> rot(J);
   std::vector<glm::vec3> trans(J);
   std::vector<glm::mat4> model(J);
-  const float duration = lc.clip.duration_s();
+  // The take as captured where there is one; a clip authored in place travels at its speed.
+  const bool take = lc.source.num_frames > 1;
+  const Clip& clip = take ? lc.source : lc.clip;
+  const float duration = clip.duration_s();
   const glm::vec3 travel =
-      lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
+      take ? glm::vec3(0.0f)
+           : lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
   const int hips = sk.role(JointRole::kHips);
   // A loop is played for one period (its end is its start); a take from its first to last frame.
-  const int steps =
-      static_cast<int>(std::floor(duration / dt_s + (lc.clip.loops ? -1e-4f : 1e-4f)));
+  const int steps = static_cast<int>(std::floor(duration / dt_s + (clip.loops ? -1e-4f : 1e-4f)));
   for (int k = 0; k <= steps; ++k) {
     const float t = k * dt_s;
-    SampleClipJob{&lc.clip, t, rot, trans}.run();
+    SampleClipJob{&clip, t, rot, trans}.run();
     glm::mat4 root(1.0f);
     root[3] = glm::vec4(travel * t, 1.0f);
     LocalToModelJob{&sk, rot, trans, root, model}.run();

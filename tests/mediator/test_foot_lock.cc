@@ -75,7 +75,6 @@ TEST(FootLock, PlantedFootIsPinnedWhereItWasDrawnAndOnlyComesDown) {
 TEST(FootLock, PlantedBelowTheClipsToeTheFootDoesNotRise) {
   // Drawn on the floor, 3 cm below the clip's toe, when it plants (the clip's toe stays 3 cm
   // above the floor): the pinned toe may not go up towards the clip's.
-  GTEST_SKIP() << "bug: lock_here's settle offset is signed, a toe planted low climbs while locked";
   Foot foot;
   foot.step({0.0f, 0.05f, 0.0f}, false, false);
   foot.goal.y = kFloor;  // as if drawn lower last frame (e.g. a release offset)
@@ -136,8 +135,6 @@ TEST(FootLock, ReleaseMovesContinuouslyAndReachesTheClipsToeAtLanding) {
 }
 
 TEST(FootLock, ReleasedAboveAVerticallyStillClipToeStillLandsOnIt) {
-  GTEST_SKIP() << "bug: a release offset above the clip's toe is never shed when the clip's toe "
-                  "has no vertical speed on the release frame";
   // Pinned on the floor while the clip's toe sinks 1 mm per frame to 1 cm below it and stays
   // there: released on a frame where the clip's toe moves only forward, the drawn toe is 1 cm
   // above the clip's. The swing (progress k / 20) lifts the clip's toe 5 cm and lands it 1 cm
