@@ -40,7 +40,8 @@ constexpr float kDropHalflife = 0.05f;  // [s]
 constexpr float kMaxHeelOff =
     1.0f;  // [rad] about 57 deg, a stance foot's plantarflexion at toe-off
 
-constexpr float kHeelHalflife = 0.05f;  // [s] a raised heel settles back this fast
+constexpr float kHeelHalflife = 0.05f;    // [s] a raised heel settles back this fast
+constexpr float kHeelUpHalflife = 0.02f;  // [s] and rises this fast
 
 // The foot's pitch about its toe [rad] that lifts an ankle at toe + d to ankle_floor (0 when it is
 // already as high): the heel rises, the ball stays.
@@ -345,23 +346,22 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     float& pitch_rate = locks_.heel_pitch_rate[k];
     if (pl.fresh[slot]) pitch = pitch_rate = 0.0f;
     const glm::vec3 toe_goal = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
-    float wanted = 0.0f;
+    float reach_pitch = 0.0f, floor_pitch = 0.0f;
     glm::vec3 pitch_axis(0.0f);
     const glm::vec3 d = goal_ankle - toe_goal;
     if (glm::length(glm::cross(d, glm::vec3(0, 1, 0))) > 1e-6f) {
       pitch_axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
       if (glm::length(goal_ankle - hip_p) > limit &&
           locks_.lock[k].state == FootLockState::kLocked) {
-        wanted = heel_off_pivot(toe_goal, goal_ankle, hip_p, limit);
+        reach_pitch = heel_off_pivot(toe_goal, goal_ankle, hip_p, limit);
       }
-      wanted = std::max(wanted, heel_to_floor(toe_goal, d, library_.planted_ankle_m[side]));
+      floor_pitch = heel_to_floor(toe_goal, d, library_.planted_ankle_m[side]);
     }
-    if (wanted >= pitch) {
-      pitch = wanted;
-      pitch_rate = 0.0f;
-    } else {
-      critical_spring(pitch, pitch_rate, wanted, kHeelHalflife, dt);
-    }
+    // Up fast (a heel that must rise cannot wait long), down slowly; both on springs, so the
+    // ankle never turns by more in a frame than a clip's joints do.
+    critical_spring(pitch, pitch_rate, reach_pitch, reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
+    // Above the floor it must be at once (a heel below the floor is seen).
+    pitch = std::max(pitch, floor_pitch);
     if (pitch > 1e-5f && glm::length(pitch_axis) > 0.5f) {
       const glm::quat r = glm::angleAxis(pitch, pitch_axis);
       goal_ankle = toe_goal + r * d;
