@@ -381,6 +381,8 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   // clip's "both feet down" would otherwise keep a stepping foot locked while it swings.
   float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
   float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f};
+  float lead_w = 0.0f;
+  uint8_t lead_plant[2] = {0, 0};
   const bool gait_votes = gait_w >= 0.25f;
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     const LocomotionClip& clip = lib.clips[lc[k]];
@@ -406,6 +408,10 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     }
     if (gait_votes && !clip.gait) continue;
     vote_w += lw[k];
+    if (lw[k] > lead_w) {
+      lead_w = lw[k];
+      for (int s = 0; s < 2; ++s) lead_plant[s] = clip.plant[s][f];
+    }
     for (int s = 0; s < 2; ++s) {
       plant[s] += lw[k] * clip.plant[s][f];
       if (!clip.swing_progress[s].empty()) swing[s] += lw[k] * clip.swing_progress[s][f];
@@ -415,6 +421,14 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   for (int s = 0; s < 2; ++s) {
     plant[s] /= std::max(vote_w, 1e-6f);
     hold[s] /= std::max(vote_w, 1e-6f);
+  }
+  // Clips blended out of step (a walk with a strafe) can split the vote so that neither foot has
+  // a majority although each clip stands on one: then the clip with the largest weight decides,
+  // so the body is never left without the foot its leading clip stands on.
+  if (plant[0] < 0.5f && plant[1] < 0.5f && (lead_plant[0] || lead_plant[1])) {
+    for (int s = 0; s < 2; ++s) {
+      if (lead_plant[s]) plant[s] = hold[s] = std::max(hold[s], 0.5f);
+    }
   }
   // 8. Feedback: the speed and torso orientation the animation can deliver.
   const int a = agent;

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -120,7 +118,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   });
   first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
   first_spine_joint_ = skeleton_.spine_chain.empty() ? num_joints_ : skeleton_.spine_chain.front();
-  dbg_ = std::getenv("GK_DBG2") != nullptr;  // TEMP
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -198,14 +195,6 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   for (int side = 0; side < 2; ++side) {
     locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
         translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
-  }
-  if (dbg_) {
-    const size_t k = static_cast<size_t>(slot) * 2;
-    const glm::vec3 t0 = locks_.drawn_toe[k], t1 = locks_.drawn_toe[k + 1];
-    std::fprintf(stderr, "E %d %d %d %.2f %.2f %.2f %.2f %d %.5f %.5f %.5f %.5f %.5f %.5f %.3f\n",
-                 slot, (int)locks_.lock[k].state, (int)locks_.lock[k + 1].state, pl.plant[0][slot],
-                 pl.plant[1][slot], pl.hold[0][slot], pl.hold[1][slot], (int)pl.standing[slot],
-                 t0.x, t0.y, t0.z, t1.x, t1.y, t1.z, pl.speed_m_s[slot]);
   }
   if (!(apm && P.foot_locking)) {
     for (int side = 0; side < 2; ++side) {
@@ -359,7 +348,8 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     }
     // Up fast (a heel that must rise cannot wait long), down slowly; both on springs, so the
     // ankle never turns by more in a frame than a clip's joints do.
-    critical_spring(pitch, pitch_rate, reach_pitch, reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
+    critical_spring(pitch, pitch_rate, reach_pitch,
+                    reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
     // Above the floor it must be at once (a heel below the floor is seen).
     pitch = std::max(pitch, floor_pitch);
     if (pitch > 1e-5f && glm::length(pitch_axis) > 0.5f) {

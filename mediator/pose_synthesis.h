@@ -89,7 +89,6 @@ class PoseSynthesizer {
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
-  bool dbg_ = false;  // TEMP
   int first_leg_joint_ = 0;
   int first_spine_joint_ = 0;
 };
