@@ -35,8 +35,8 @@ struct MediatorParams {
   float stop_speed_m_s = 0.08f;     // [m/s] [Limit: 0..0.5] below this the agent stands
   // 7. Foot locking.
   bool foot_locking = true;
-  float lock_release_s = 0.12f;    // [s] [Limit: 0.02..0.5] blend-out time of a released lock
-  float max_leg_stretch = 0.995f;  // [ratio of leg length] [Limit: 0.9..1] locks beyond release
+  float lock_release_s = 0.12f;    // [s] [Limit: 0.02..0.5] shortest rejoin of a released foot
+  float max_leg_stretch = 0.995f;  // [ratio of leg length] [Limit: 0.9..1] beyond: heel up, step
   float idle_step_distance_m =
       0.12f;                       // [m] [Limit: 0.02..0.5] planted-foot drift that triggers a step
   float idle_step_time_s = 0.35f;  // [s] [Limit: 0.1..1] duration of a re-planting step
