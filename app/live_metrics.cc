@@ -1,5 +1,6 @@
 #include "app/live_metrics.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -22,8 +23,27 @@ void LiveMetrics::record(const CrowdSession& session, const AnimationLane& lane,
   const AgentFrame& frame = session.frame();
   const AnimationPlans& plans = lane.mediator->plans();
   double torsion = 0.0, rate = 0.0, root_error = 0.0;
+  // METRICS.md v2 on this frame: walking agents with neither toe within 5 cm of its floor, and
+  // the deepest foot (toe or ankle) below its floor.
+  const LocomotionLibrary& lib = session.library();
+  const Skeleton& sk = *lib.skeleton;
+  int walking = 0, floating = 0;
+  float deepest = 0.0f;
   for (size_t i = 0; i < frame.size(); ++i) {
     const int slot = plans.slot_of_agent[i];
+    const auto w = lane.poses->world(slot);
+    bool near = false;
+    for (int s = 0; s < 2; ++s) {
+      const float toe = w[sk.toe(static_cast<Side>(s))][3].y - lib.planted_toe_m[s];
+      const float ankle = w[sk.ankle(static_cast<Side>(s))][3].y - lib.planted_ankle_m[s];
+      near = near || toe <= 0.05f;
+      deepest = std::max({deepest, -toe, -ankle});
+    }
+    const float speed = plans.speed_m_s[slot];
+    if (speed >= 0.1f && speed <= 2.2f) {
+      ++walking;
+      if (!near) ++floating;
+    }
     torsion += std::abs(lane.poses->torsion(slot));
     rate += plans.playback_rate[slot];
     // The rendered root is the skeleton's root joint (the pelvis) projected on the ground.
@@ -34,6 +54,8 @@ void LiveMetrics::record(const CrowdSession& session, const AnimationLane& lane,
   std::array<float, kNumLiveSeries> v{};
   v[static_cast<int>(LiveSeries::kSlide)] = history.last_slide_m_s() * 100.0f;
   v[static_cast<int>(LiveSeries::kSkate)] = history.last_skate_ratio() * 100.0f;
+  v[static_cast<int>(LiveSeries::kFloat)] = walking ? 100.0f * floating / walking : 0.0f;
+  v[static_cast<int>(LiveSeries::kPenetration)] = 100.0f * deepest;
   v[static_cast<int>(LiveSeries::kTorsion)] = static_cast<float>(torsion / n * 57.29578);
   v[static_cast<int>(LiveSeries::kRate)] = static_cast<float>(rate / n);
   v[static_cast<int>(LiveSeries::kRootError)] = static_cast<float>(root_error / n * 100.0);
@@ -62,9 +84,13 @@ float LiveMetrics::mean(LiveSeries s) const {
 const char* LiveMetrics::label(LiveSeries s) {
   switch (s) {
     case LiveSeries::kSlide:
-      return "foot slide";
+      return "support-foot slide";
     case LiveSeries::kSkate:
       return "skating feet";
+    case LiveSeries::kFloat:
+      return "floating walkers";
+    case LiveSeries::kPenetration:
+      return "deepest foot below floor";
     case LiveSeries::kTorsion:
       return "torsion";
     case LiveSeries::kRate:
@@ -82,6 +108,10 @@ const char* LiveMetrics::unit(LiveSeries s) {
       return "cm/s";
     case LiveSeries::kSkate:
       return "%";
+    case LiveSeries::kFloat:
+      return "%";
+    case LiveSeries::kPenetration:
+      return "cm";
     case LiveSeries::kTorsion:
       return "deg";
     case LiveSeries::kRate:

@@ -12,7 +12,16 @@
 
 namespace gk::app {
 
-enum class LiveSeries : int { kSlide, kSkate, kTorsion, kRate, kRootError, kCount };
+enum class LiveSeries : int {
+  kSlide,
+  kSkate,
+  kFloat,
+  kPenetration,
+  kTorsion,
+  kRate,
+  kRootError,
+  kCount
+};
 inline constexpr int kNumLiveSeries = static_cast<int>(LiveSeries::kCount);
 
 enum class LiveStage : int { kSim, kMediator, kPose, kUpload, kRender, kFrame, kCount };

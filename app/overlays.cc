@@ -38,7 +38,7 @@ OverlayHistory::OverlayHistory(const CrowdSession& session, size_t capacity)
   for (int s = 0; s < 2; ++s) {
     toe_joint_[s] = sk.toe(static_cast<Side>(s));
     if (toe_joint_[s] < 0) toe_joint_[s] = sk.ankle(static_cast<Side>(s));
-    toe_floor_m_[s] = lib.toe_floor_m[s];
+    toe_floor_m_[s] = lib.planted_toe_m[s];
   }
   slot_id_.assign(capacity_, -1);
   count_.assign(capacity_, 0);
@@ -49,8 +49,8 @@ OverlayHistory::OverlayHistory(const CrowdSession& session, size_t capacity)
 void OverlayHistory::record(const CrowdSession& session, const AnimationLane& lane, float dt_s) {
   const AgentFrame& frame = session.frame();
   const AnimationPlans& plans = lane.mediator->plans();
-  // METRICS.md's contact test, against the library's flat-foot toe height.
-  constexpr float kContactTolerance_m = 0.025f;
+  // METRICS.md v2: the support foot (the lower toe against its floor) within 5 cm of that floor.
+  constexpr float kNearFloor_m = 0.05f;
   double slide_sum = 0.0;
   int samples = 0, skates = 0;
   for (size_t i = 0; i < frame.size(); ++i) {
@@ -59,13 +59,18 @@ void OverlayHistory::record(const CrowdSession& session, const AnimationLane& la
     if (slot_id_[slot] != frame.ids[i]) slot_id_[slot] = frame.ids[i], count_[slot] = 0;
     const int k = count_[slot];
     const auto world = lane.poses->world(static_cast<int>(slot));
+    float rel[2] = {1e9f, 1e9f};
+    for (int s = 0; s < 2; ++s) {
+      if (toe_joint_[s] >= 0) rel[s] = world[toe_joint_[s]][3].y - toe_floor_m_[s];
+    }
+    const int support = rel[1] < rel[0] ? 1 : 0;
     for (int s = 0; s < 2; ++s) {
       if (toe_joint_[s] < 0) continue;
       const glm::vec3 p(world[toe_joint_[s]][3]);
       ToeSample* ring = &toes_[(slot * 2 + s) * kTrailLength];
       ToeSample& cur = ring[k % kTrailLength];
       const ToeSample& prev = ring[(k + kTrailLength - 1) % kTrailLength];
-      const bool contact = p.y <= toe_floor_m_[s] + kContactTolerance_m;
+      const bool contact = s == support && rel[s] <= kNearFloor_m;
       float slide = contact ? 0.0f : -1.0f;
       if (contact && k > 0 && prev.slide_m_s >= 0.0f) {
         slide = glm::length(glm::vec2(p.x - prev.position.x, p.z - prev.position.z)) / dt_s;

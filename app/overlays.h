@@ -19,8 +19,9 @@ struct OverlayToggles {
   bool theta = false;     // desired torso orientation (yellow, above the head)
   bool facing = false;    // lower body = pelvis (blue, hip height), upper body = chest (orange)
   bool planted = false;   // locked feet: crosses at the lock targets (white)
-  bool trails = false;    // toe positions while on the ground, green (still) .. red (>= 30 cm/s)
-  bool paths = false;     // root path of the last 4 s (violet)
+  bool trails = false;  // support-foot toe within 5 cm of its floor (METRICS.md v2), green (still)
+                        // .. red (>= 30 cm/s)
+  bool paths = false;   // root path of the last 4 s (violet)
   bool any() const { return velocity || theta || facing || planted || trails || paths; }
 };
 
@@ -32,8 +33,9 @@ class OverlayHistory {
   OverlayHistory(const CrowdSession& session, size_t capacity);
   // Appends this frame's toe and root positions of every live agent of the lane.
   void record(const CrowdSession& session, const AnimationLane& lane, float dt_s);
-  // Mean slide speed of the feet in contact on the last recorded frame [m/s] (both this frame and
-  // the previous one in contact, METRICS.md's test), and the share of them above kSkateSpeed_m_s.
+  // Mean support-foot slide on the last recorded frame [m/s] (the same foot the support within
+  // 5 cm of its floor on this frame and the previous one: METRICS.md v2), and the share of those
+  // samples above kSkateSpeed_m_s.
   float last_slide_m_s() const { return last_slide_m_s_; }
   float last_skate_ratio() const { return last_skate_ratio_; }
   // Queues the enabled overlays as debug lines. `selected_id` (or -1) gets a ring at its feet.
