@@ -20,6 +20,12 @@ constexpr float kSwitchHysteresis =
     0.26f;  // [rad] a new travel direction group must be this much better
 
 bool finite2(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+// [m] Positions further out than this from the origin are a simulator's garbage (1e30), not a
+// place; a float there cannot even hold a footstep.
+constexpr float kMaxCoordinate = 1e6f;
+bool usable_position(const glm::vec2& p) {
+  return finite2(p) && std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate;
+}
 float heading2(const glm::vec2& v) { return std::atan2(v.x, v.y); }
 
 // Speed bracket within one direction group, with the standing clip at speed 0 below it.
@@ -109,7 +115,7 @@ void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::v
   const float yaw = speed > params_.stop_speed_m_s ? heading2(vel) : th;
   plans_.lower_yaw[slot] = yaw;
   lower_target_[slot] = yaw;
-  plans_.root_xz[slot] = finite2(p) ? p : glm::vec2(0.0f);
+  plans_.root_xz[slot] = usable_position(p) ? p : glm::vec2(0.0f);
   plans_.fresh[slot] = 1;
   // Variety: a random start phase and cadence, from the seed and the id (order-independent).
   std::mt19937_64 rng(params_.seed * 0x9E3779B97F4A7C15ull + id);
@@ -227,7 +233,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   });
   for (size_t i = 0; i < n; ++i) {
     const glm::vec2 v = frame.velocities[i];
-    if (!finite2(v) || glm::length(v) > kAbsurdSpeed || !finite2(frame.positions[i]) ||
+    if (!finite2(v) || glm::length(v) > kAbsurdSpeed || !usable_position(frame.positions[i]) ||
         !std::isfinite(frame.thetas[i])) {
       ++num_sanitised_;
     }
@@ -243,7 +249,7 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   AnimationPlans& pl = plans_;
 
   // Sanitise what the simulator gave (NaN, absurd speeds): hold the last good values.
-  const glm::vec2 p = finite2(p_in) ? p_in : pl.root_xz[slot];
+  const glm::vec2 p = usable_position(p_in) ? p_in : pl.root_xz[slot];
   glm::vec2 v = finite2(v_in) ? v_in : vel_[slot];
   if (glm::length(v) > kAbsurdSpeed) v = vel_[slot];
   const float theta_raw = std::isfinite(theta_in) ? theta_in : theta_[slot];

@@ -93,7 +93,11 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
       const float asked = std::abs(wrap_pi(frame.thetas[i] - poses.pelvis_heading(slot))) * kDeg;
       if (asked <= P.torsion_limit_deg) facing_within_.push_back(err);
     }
-    root_error_.push_back(100.0f * glm::length(root - frame.positions[i]));
+    // A simulator's garbage position (sanitised by the mediator) has no distance to measure.
+    const glm::vec2 p = frame.positions[i];
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::abs(p.x) < 1e6f && std::abs(p.y) < 1e6f) {
+      root_error_.push_back(100.0f * glm::length(root - p));
+    }
     if (continues) {
       const glm::vec2 vel = (root - prev_root) / dt_;
       if (glm::length(vel) > kMinHeadingSpeed) {
