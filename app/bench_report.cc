@@ -205,13 +205,11 @@ nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& 
         {"penetration_ratio", fr ? json(v.penetration_ratio) : json(nullptr)},
         {"limb_pop_rate", fr ? json(v.limb_pop_rate) : json(nullptr)},
         {"gmd_skate_ratio", v.gmd_frames ? json(v.gmd_skate_ratio) : json(nullptr)},
-        {"support_samples", v.support_samples},
+        {"support_slide_samples", v.support_samples},
         {"limb_pops", v.limb_pops},
     };
   };
-  const ViewerFeetStats& f = m.feet;
-  const bool support = f.support_samples > 0, frames = f.agent_frames > 0;
-  return {
+  json out = {
       {"foot_slide_cm_s", slid ? json(m.slide.mean_cm_s) : json(nullptr)},
       {"foot_slide_p95_cm_s", slid ? json(m.slide.p95_cm_s) : json(nullptr)},
       {"skate_ratio", slid ? json(m.slide.skate_ratio) : json(nullptr)},
@@ -248,19 +246,10 @@ nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& 
       {"max_root_jerk", m.max_root_jerk},
       {"floor_m", floor_m},
       {"limb_accel_reference_m_s2", accel_ref},
-      {"support_slide_cm_s", support ? json(f.support_slide_cm_s) : json(nullptr)},
-      {"support_slide_p95_cm_s", support ? json(f.support_slide_p95_cm_s) : json(nullptr)},
-      {"support_skate_ratio", support ? json(f.support_skate_ratio) : json(nullptr)},
-      {"float_ratio", f.float_samples ? json(f.float_ratio) : json(nullptr)},
-      {"penetration_cm",
-       {{"p99", frames ? json(f.penetration_p99_cm) : json(nullptr)},
-        {"max", frames ? json(f.penetration_max_cm) : json(nullptr)}}},
-      {"penetration_ratio", frames ? json(f.penetration_ratio) : json(nullptr)},
-      {"limb_pop_rate", frames ? json(f.limb_pop_rate) : json(nullptr)},
-      {"gmd_skate_ratio", f.gmd_frames ? json(f.gmd_skate_ratio) : json(nullptr)},
-      {"support_slide_samples", f.support_samples},
       {"feet_floor", feet_json(m.feet_floor)},
   };
+  out.update(feet_json(m.feet));  // the v2 figures of the run, beside those of the clips
+  return out;
 }
 
 }  // namespace gk::app
