@@ -12,8 +12,8 @@
 namespace gk {
 
 struct PoseSynthesizer::Scratch {
-  std::vector<glm::quat> rot;    // kMaxBlendLayers * joints
-  std::vector<glm::vec3> trans;  // kMaxBlendLayers * joints
+  std::vector<glm::quat> rot;    // 2 * kMaxBlendLayers * joints (a layer and its seam sample)
+  std::vector<glm::vec3> trans;  // 2 * kMaxBlendLayers * joints
 };
 
 namespace {
@@ -26,17 +26,28 @@ glm::mat4 root_placement(const glm::vec2& xz, float yaw) {
 
 glm::quat rotation_of(const glm::mat4& m) { return glm::normalize(glm::quat_cast(glm::mat3(m))); }
 
+// 0 -> 1 with zero slope at both ends.
+float smoothstep01(float x) {
+  x = std::clamp(x, 0.0f, 1.0f);
+  return x * x * (3.0f - 2.0f * x);
+}
+
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
 // kMaxDrop, on a critically damped spring of halflife kDropHalflife (no vertical snap).
 constexpr float kDropReach = 0.99f;
 constexpr float kMaxDrop = 0.04f;       // [m]
 constexpr float kDropHalflife = 0.05f;  // [s]
 
-// The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
-// about the ball, never past kMaxHeelOff (bisection; the distance grows monotonically less as the
-// heel rises toward the hip).
-constexpr float kMaxHeelOff =
-    1.0f;  // [rad] about 57 deg, a stance foot's plantarflexion at toe-off
+// A raised heel puts the toe -> ankle line at most this steep [rad] (about 57 deg, a stance
+// foot's plantarflexion at toe-off): the pivot never turns a foot past standing on its tip.
+constexpr float kMaxHeelOff = 1.0f;
+
+// How much more the foot may pitch up from its elevation (toe -> ankle vector d) [rad].
+float heel_room(const glm::vec3& d) {
+  const float len = glm::length(d);
+  if (len < 1e-6f) return 0.0f;
+  return std::max(0.0f, kMaxHeelOff - std::asin(std::clamp(d.y / len, -1.0f, 1.0f)));
+}
 
 constexpr float kHeelHalflife = 0.05f;    // [s] a raised heel settles back this fast
 constexpr float kHeelUpHalflife = 0.02f;  // [s] and rises this fast
@@ -48,17 +59,21 @@ float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle_floor)
   if (len < 1e-6f || toe.y + d.y >= ankle_floor) return 0.0f;
   const float now = std::asin(std::clamp(d.y / len, -1.0f, 1.0f));
   const float want = std::asin(std::clamp((ankle_floor - toe.y) / len, -1.0f, 1.0f));
-  return std::clamp(want - now, 0.0f, kMaxHeelOff);
+  return std::clamp(want - now, 0.0f, heel_room(d));
 }
 
 // Returns the pitch [rad].
+// The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
+// about the ball, as far as heel_room allows (bisection; the distance shrinks as the heel rises
+// toward the hip).
 float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
                      float limit) {
   const glm::vec3 d = ankle - toe;
   const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
+  const float room = heel_room(d);
   auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
-  if (dist(kMaxHeelOff) > limit) return kMaxHeelOff;
-  float lo = 0.0f, hi = kMaxHeelOff;
+  if (dist(room) > limit) return room;
+  float lo = 0.0f, hi = room;
   for (int i = 0; i < 12; ++i) {
     const float mid = 0.5f * (lo + hi);
     (dist(mid) > limit ? lo : hi) = mid;
@@ -112,8 +127,8 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J] {
     Scratch s;
-    s.rot.resize(kMaxBlendLayers * J);
-    s.trans.resize(kMaxBlendLayers * J);
+    s.rot.resize(2 * kMaxBlendLayers * J);
+    s.trans.resize(2 * kMaxBlendLayers * J);
     return s;
   });
   first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
@@ -154,16 +169,33 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   }
 
   // Sample and blend the planned layers.
-  PoseLayer layers[kMaxBlendLayers];
+  PoseLayer layers[2 * kMaxBlendLayers];
   int num_layers = 0;
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
     if (w <= 0.0f) continue;
-    const Clip& clip = library_.clips[pl.layer_clip[slot * kMaxBlendLayers + k]].clip;
+    const LocomotionClip& lc = library_.clips[pl.layer_clip[slot * kMaxBlendLayers + k]];
+    const float time = pl.layer_time_s[slot * kMaxBlendLayers + k];
     std::span<glm::quat> r(s.rot.data() + num_layers * J, J);
     std::span<glm::vec3> t(s.trans.data() + num_layers * J, J);
-    SampleClipJob{&clip, pl.layer_time_s[slot * kMaxBlendLayers + k], r, t}.run();
-    layers[num_layers++] = {r, t, w};
+    SampleClipJob{&lc.clip, time, r, t}.run();
+    // A take (not a loop) replays one stride of itself: its last pose is not quite its first, so
+    // over the stride's last fifth the pose one stride earlier is blended in, and the wrap to the
+    // stride's start joins exactly.
+    float seam = 0.0f;
+    if (lc.gait && !lc.clip.loops) {
+      const float t0 = lc.phase_to_time[0], t1 = lc.phase_to_time[kPhaseTableSize];
+      const float u = (time - t0) / std::max(t1 - t0, 1e-4f);
+      seam = time - (t1 - t0) >= 0.0f ? smoothstep01((u - 0.8f) / 0.2f) : 0.0f;
+    }
+    layers[num_layers++] = {r, t, w * (1.0f - seam)};
+    if (seam > 0.0f) {
+      const float earlier = time - (lc.phase_to_time[kPhaseTableSize] - lc.phase_to_time[0]);
+      std::span<glm::quat> r2(s.rot.data() + num_layers * J, J);
+      std::span<glm::vec3> t2(s.trans.data() + num_layers * J, J);
+      SampleClipJob{&lc.clip, earlier, r2, t2}.run();
+      layers[num_layers++] = {r2, t2, w * seam};
+    }
   }
   std::span<glm::quat> out_r(local_rot_.data() + base, J);
   std::span<glm::vec3> out_t(local_trans_.data() + base, J);
