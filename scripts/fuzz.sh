@@ -9,6 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 data="${GAITKEEPER_DATA:-$(cd .. && pwd)/shared/data}"
+export LC_ALL=C  # byte lengths (${#json}) and byte-wise tools
 jobs=$(nproc)
 
 seconds=60
@@ -54,6 +55,16 @@ seed fuzz_bvh "$data"/clips/bvh/*.bvh "$data"/clips/bvh/more/*.bvh tests/data/go
 seed fuzz_gltf "$data"/clips/gltf/*.glb tests/data/good/*.gltf tests/data/bad/*.gltf
 seed fuzz_scenario data/scenarios/*.json tests/data/bad/scenarios/*.json
 seed fuzz_trajectory "$data"/trajectories/*/*.txt tests/data/bad/trajectories/*.txt
+# The .gltf fixtures again as small .glb files (a JSON chunk only; their buffers are data: URIs),
+# so that the binary path has seeds other than the 3 MB mannequin.
+le32() { printf '\\x%02x\\x%02x\\x%02x\\x%02x' $(($1 & 255)) $(($1 >> 8 & 255)) \
+  $(($1 >> 16 & 255)) $(($1 >> 24 & 255)); }
+for f in tests/data/good/*.gltf tests/data/bad/*.gltf; do
+  json=$(tr -d '\n' <"$f")
+  while ((${#json} % 4)); do json+=" "; done
+  printf "glTF$(le32 2)$(le32 $((20 + ${#json})))$(le32 ${#json})JSON%s" "$json" \
+    >"$out/corpus/fuzz_gltf/seed_$(basename "$f" .gltf).glb"
+done
 shopt -u nullglob
 
 # Parameter names from the table in mediator/params.cc; values inside and outside their limits.

@@ -133,6 +133,17 @@ TEST(GltfFixture, ParseFromMemoryMatchesTheFileLoader) {
   ASSERT_FALSE(bad_set.ok());
   EXPECT_EQ(bad_set.message().rfind("memory.gltf: animations[0].channels[1].sampler", 0), 0u)
       << bad_set.message();
+  // The same JSON in a GLB container (a JSON chunk only: the buffers are data: URIs).
+  std::string json = read(good);
+  json.resize((json.size() + 3) / 4 * 4, ' ');
+  auto le32 = [](uint32_t v) {
+    return std::string{char(v & 255), char(v >> 8 & 255), char(v >> 16 & 255), char(v >> 24)};
+  };
+  const auto json_size = static_cast<uint32_t>(json.size());
+  const std::string glb = "glTF" + le32(2) + le32(20 + json_size) + le32(json_size) + "JSON" + json;
+  Result<ClipSet> from_glb = parse_gltf(glb, "memory.glb");
+  ASSERT_TRUE(from_glb.ok()) << from_glb.message();
+  EXPECT_EQ(from_glb->skeleton->names, from_file->skeleton->names);
   EXPECT_FALSE(parse_gltf("glTF\x02", "short.glb").ok());
   EXPECT_FALSE(parse_gltf("", "empty.gltf").ok());
 }
