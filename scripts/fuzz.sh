@@ -6,6 +6,7 @@
 # the fuzzers add between runs. Crashes, leaks, timeouts and out-of-memory inputs are written to
 # build-fuzz/findings/<target>/ and make the script exit with 1.
 # Usage: scripts/fuzz.sh [SECONDS | --smoke] [TARGET...]    (--smoke: 10 s per target, for CI)
+# GK_FUZZ_ARGS adds libFuzzer flags to every run (e.g. GK_FUZZ_ARGS="-seed=1 -jobs=1").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 data="${GAITKEEPER_DATA:-$(cd .. && pwd)/shared/data}"
@@ -40,7 +41,10 @@ seed() {
   shift
   mkdir -p "$dir"
   for f in "$@"; do
-    if [[ -f "$f" ]]; then cp -f "$f" "$dir/seed_$(basename "$f")"; fi
+    if [[ -f "$f" ]]; then
+      cp -f "$f" "$dir/seed_$(basename "$f")"
+      chmod u+w "$dir/seed_$(basename "$f")"  # the shared data is read-only
+    fi
   done
 }
 # seed_text TARGET NAME TEXT: one generated seed.
@@ -101,6 +105,8 @@ for t in "${targets[@]}"; do
   args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
     -artifact_prefix="$out/findings/$t/" -max_len="${max_len[$t]:-16384}")
   if [[ -n "${dict[$t]:-}" ]]; then args+=(-dict="fuzz/dict/${dict[$t]}.dict"); fi
+  # shellcheck disable=SC2206  # GK_FUZZ_ARGS: more libFuzzer flags, split on spaces (last wins)
+  args+=(${GK_FUZZ_ARGS:-})
   echo "== fuzz: $t for ${seconds} s"
   touch "$log.start"
   rc=0
