@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -329,23 +330,16 @@ void apply_scale(float s, Skeleton* skeleton, std::vector<Clip>* clips,
   *mesh = std::move(scaled);
 }
 
-}  // namespace
+// tinygltf's errors may quote the file (a JSON parse error of a binary file): keep them
+// printable.
+Status tinygltf_error(const std::string& path, const std::string& err) {
+  return Status::Error(path + ": " +
+                       (err.empty() ? "cannot load glTF" : printable_snippet(err, 400)));
+}
 
-Result<ClipSet> load_gltf(const std::string& path, const LoadOptions& options) {
-  GK_RETURN_IF_ERROR(check_input_file(path, "glTF file"));
-  tinygltf::TinyGLTF loader;
-  tinygltf::Model model;
-  std::string err, warn;
-  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                                : loader.LoadASCIIFromFile(&model, &err, &warn, path);
-  // tinygltf's errors may quote the file (a JSON parse error of a binary file): keep them
-  // printable.
-  if (!ok) {
-    return Status::Error(path + ": " +
-                         (err.empty() ? "cannot load glTF" : printable_snippet(err, 400)));
-  }
+// Everything after tinygltf's parse: the skeleton, the clips and the mesh, every index checked.
+Result<ClipSet> clips_from_model(const tinygltf::Model& model, const std::string& path,
+                                 const LoadOptions& options) {
   if (model.skins.empty()) return Status::AtField(path, "skins", "no skin (a skeleton is needed)");
 
   // Parent of every node, rejecting shared children and cycles before anything walks up the tree.
@@ -426,6 +420,43 @@ Result<ClipSet> load_gltf(const std::string& path, const LoadOptions& options) {
   set.mesh = *mesh;
   set.skeleton = build->skeleton;
   return set;
+}
+
+}  // namespace
+
+Result<ClipSet> load_gltf(const std::string& path, const LoadOptions& options) {
+  GK_RETURN_IF_ERROR(check_input_file(path, "glTF file"));
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string err, warn;
+  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                                : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  if (!ok) return tinygltf_error(path, err);
+  return clips_from_model(model, path, options);
+}
+
+Result<ClipSet> parse_gltf(std::string_view bytes, const std::string& source_name,
+                           const LoadOptions& options) {
+  // tinygltf takes an unsigned int length.
+  if (bytes.size() > std::numeric_limits<uint32_t>::max()) {
+    return Status::Error(source_name + ": larger than 4 GiB, expected a glTF or GLB file");
+  }
+  const size_t slash = source_name.find_last_of('/');
+  const std::string base_dir = slash == std::string::npos ? "" : source_name.substr(0, slash);
+  const auto length = static_cast<unsigned int>(bytes.size());
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string err, warn;
+  const bool ok =
+      bytes.starts_with("glTF")
+          ? loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                        reinterpret_cast<const unsigned char*>(bytes.data()),
+                                        length, base_dir)
+          : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), length, base_dir);
+  if (!ok) return tinygltf_error(source_name, err);
+  return clips_from_model(model, source_name, options);
 }
 
 }  // namespace gk

@@ -4,6 +4,7 @@
 // inverse bind matrices) for the renderer. Errors name the file and the glTF field.
 
 #include <string>
+#include <string_view>
 
 #include "animation/bvh_loader.h"  // LoadOptions
 #include "animation/clip.h"
@@ -11,5 +12,9 @@
 namespace gk {
 
 Result<ClipSet> load_gltf(const std::string& path, const LoadOptions& options = {});
+// Same, from the bytes of a .glb (starting with the "glTF" magic) or .gltf file in memory;
+// source_name labels the errors, and external buffer URIs resolve against its folder.
+Result<ClipSet> parse_gltf(std::string_view bytes, const std::string& source_name,
+                           const LoadOptions& options = {});
 
 }  // namespace gk

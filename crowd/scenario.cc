@@ -39,7 +39,6 @@ struct Range {
 };
 constexpr Range kAnyCoordinate{-kMaxCoordinate, kMaxCoordinate, false, "a number in [-1e5, 1e5]"};
 constexpr Range kPositive{0.0f, kMaxCoordinate, true, "a number > 0"};
-constexpr Range kNonNegative{0.0f, kMaxCoordinate, false, "a number >= 0"};
 constexpr Range kUnit{0.0f, 1.0f, false, "a number in [0, 1]"};
 
 class Parser {

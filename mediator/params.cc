@@ -157,7 +157,12 @@ Status set_mediator_param(std::string_view assignment, MediatorParams* params) {
 Status load_mediator_params_json(const std::string& path, MediatorParams* params) {
   Result<std::string> text = read_file_bytes(path, kMaxParamFileBytes, "parameter file");
   if (!text.ok()) return text.status();
-  Result<nlohmann::json> parsed = parse_json_text(*text, path);
+  return parse_mediator_params_json(*text, path, params);
+}
+
+Status parse_mediator_params_json(std::string_view json_text, const std::string& path,
+                                  MediatorParams* params) {
+  Result<nlohmann::json> parsed = parse_json_text(json_text, path);
   if (!parsed.ok()) return parsed.status();
   const nlohmann::json& j = *parsed;
   if (!j.is_object()) return Status::Error(path + ": expected a JSON object of parameters");

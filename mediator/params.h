@@ -67,6 +67,9 @@ std::span<const ParamInfo> mediator_param_infos();
 Status set_mediator_param(std::string_view assignment, MediatorParams* params);
 // {"torsion_limit_deg": 40, "mode": "apm", ...}; errors name the file and the field.
 Status load_mediator_params_json(const std::string& path, MediatorParams* params);
+// Same, from JSON text in memory; source_name labels the errors.
+Status parse_mediator_params_json(std::string_view json_text, const std::string& source_name,
+                                  MediatorParams* params);
 Status validate_mediator_params(const MediatorParams& params);
 
 }  // namespace gk

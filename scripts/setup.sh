@@ -15,6 +15,7 @@ PACKAGES=(
   libcli11-dev libtbb-dev librecast-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth ffmpeg jq
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
 #include <vector>
@@ -107,6 +109,43 @@ TEST(GltfFixture, EachBadFileHasItsSpecificError) {
         << "expected '" << expected << "' in '" << set.message() << "'";
   }
   EXPECT_FALSE(load_gltf(fixture("bad/does_not_exist.glb")).ok());
+}
+
+// parse_gltf (bytes in memory, used by the fuzzer) gives the file loader's result and errors.
+TEST(GltfFixture, ParseFromMemoryMatchesTheFileLoader) {
+  auto read = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string good = fixture("good/two_bone_skin.gltf");
+  Result<ClipSet> from_file = load_gltf(good);
+  Result<ClipSet> from_memory = parse_gltf(read(good), good);
+  ASSERT_TRUE(from_file.ok()) << from_file.message();
+  ASSERT_TRUE(from_memory.ok()) << from_memory.message();
+  EXPECT_EQ(from_memory->skeleton->names, from_file->skeleton->names);
+  ASSERT_EQ(from_memory->clips.size(), from_file->clips.size());
+  EXPECT_EQ(from_memory->clips[0].rotations, from_file->clips[0].rotations);
+  ASSERT_TRUE(from_memory->mesh);
+  EXPECT_EQ(from_memory->mesh->num_vertices(), 3);
+
+  const std::string bad = fixture("bad/gltf_sampler_index.gltf");
+  Result<ClipSet> bad_set = parse_gltf(read(bad), "memory.gltf");
+  ASSERT_FALSE(bad_set.ok());
+  EXPECT_EQ(bad_set.message().rfind("memory.gltf: animations[0].channels[1].sampler", 0), 0u)
+      << bad_set.message();
+  // The same JSON in a GLB container (a JSON chunk only: the buffers are data: URIs).
+  std::string json = read(good);
+  json.resize((json.size() + 3) / 4 * 4, ' ');
+  auto le32 = [](uint32_t v) {
+    return std::string{char(v & 255), char(v >> 8 & 255), char(v >> 16 & 255), char(v >> 24)};
+  };
+  const auto json_size = static_cast<uint32_t>(json.size());
+  const std::string glb = "glTF" + le32(2) + le32(20 + json_size) + le32(json_size) + "JSON" + json;
+  Result<ClipSet> from_glb = parse_gltf(glb, "memory.glb");
+  ASSERT_TRUE(from_glb.ok()) << from_glb.message();
+  EXPECT_EQ(from_glb->skeleton->names, from_file->skeleton->names);
+  EXPECT_FALSE(parse_gltf("glTF\x02", "short.glb").ok());
+  EXPECT_FALSE(parse_gltf("", "empty.gltf").ok());
 }
 
 // The mannequin is loaded once for the tests below (about 0.1 s).

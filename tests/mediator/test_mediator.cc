@@ -253,6 +253,19 @@ TEST(MediatorParams, JsonNumberTooLargeNamesFileAndLine) {
   EXPECT_EQ(p.torsion_limit_deg, MediatorParams{}.torsion_limit_deg);
 }
 
+TEST(MediatorParams, JsonTextInMemorySetsAndNamesTheSource) {
+  MediatorParams p;
+  ASSERT_TRUE(
+      parse_mediator_params_json(R"({"torsion_limit_deg": 40, "foot_locking": false})", "mem", &p)
+          .ok());
+  EXPECT_EQ(p.torsion_limit_deg, 40.0f);
+  EXPECT_FALSE(p.foot_locking);
+  const Status s = parse_mediator_params_json(R"({"torsion_limit_deg": 400})", "mem.json", &p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().rfind("mem.json: torsion_limit_deg", 0), 0u) << s.message();
+  EXPECT_FALSE(parse_mediator_params_json("[1, 2]", "mem.json", &p).ok());
+}
+
 TEST(MediatorParams, DirectoryIsNotAParameterFile) {
   const std::string dir = test::scratch_dir("params") + "/folder.json";
   std::filesystem::create_directories(dir);
