@@ -31,9 +31,9 @@ struct LocomotionClip {
   // Clip time [s] at phase k / kPhaseTableSize over one cycle (monotone, may exceed the duration of
   // a looping clip; sampling wraps).
   float phase_to_time[kPhaseTableSize + 1] = {};
-  // Per clip frame and foot (Side): `plant` where a foot lock may start (the foot is down by the
-  // METRICS.md contact test and nearly still on the ground, or the analysis says contact), `hold`
-  // where an existing lock is kept (the foot has not clearly lifted yet).
+  // Per clip frame and foot (Side): `plant` where a foot lock may start (clip analysis has the
+  // foot in contact), `hold` where an existing lock is kept (in contact, or the ball still no
+  // higher and no faster over the ground than in 90% of this clip's contact frames: heel-off).
   std::vector<uint8_t> plant[2];
   std::vector<uint8_t> hold[2];
   std::vector<float> toe_height_m[2];  // toe height above its lowest point
