@@ -16,8 +16,8 @@ mkdir -p out
 "$gk" render --scenario gallery --frames 300 --compare --out out/demo.png "$@"
 echo
 echo "== gaitkeeper bench --scenario gallery --mode naive | apm  (the same crowd, measured)"
-"$gk" bench --scenario gallery --mode naive | grep -E "foot slide|torsion"
-"$gk" bench --scenario gallery --mode apm | grep -E "foot slide|torsion"
+"$gk" bench --scenario gallery --mode naive | grep -E "foot slide|v2 feet|torsion"
+"$gk" bench --scenario gallery --mode apm | grep -E "foot slide|v2 feet|torsion"
 echo
 echo "Wrote out/demo.mp4 and out/demo.png (left: naive, right: apm). Run it with a display"
 echo "for the window, or see: $gk --help"
