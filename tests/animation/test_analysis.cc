@@ -141,6 +141,43 @@ TEST(Analysis, PhaseIsZeroAtLeftContactsAndIncreases) {
   EXPECT_EQ(backward, 0);
 }
 
+// CMU subject 16 (clips/bvh/more: a cgspeed 120 fps take in CMU units and MRL 30 fps retargets in
+// centimetres): the steady takes' speeds match the root speeds PROVENANCE.md measured
+// independently (within 5%), and left and right contacts alternate (a contact already under way
+// on the first frame starts no step).
+TEST(Analysis, SubjectSixteenSteadyTakes) {
+  struct Take {
+    const char* file;
+    float speed_m_s;  // PROVENANCE.md "Average root speed"
+  };
+  for (const Take& t : {Take{"clips/bvh/more/cmu_16_11_walk_veer_left.bvh", 0.96f},
+                        Take{"clips/bvh/more/cmu_16_15_walk_mrl30.bvh", 1.17f},
+                        Take{"clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh", 1.73f},
+                        Take{"clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh", 2.86f}}) {
+    GK_REQUIRE_DATA(t.file);
+    const Loaded l = load_and_analyze(t.file);
+    const ClipAnalysis& a = l.analysis;
+    EXPECT_NEAR(a.native_speed_m_s, t.speed_m_s, 0.05f * t.speed_m_s) << t.file;
+    EXPECT_LT(std::abs(a.direction_rad), 0.1f) << t.file;  // forward, the way it faces
+    struct Start {
+      float t;
+      int side;
+    };
+    std::vector<Start> starts;
+    for (int s = 0; s < 2; ++s) {
+      for (const TimeInterval& c : a.contacts[s]) {
+        if (c.start_s > 0.5f / a.fps) starts.push_back({c.start_s, s});
+      }
+    }
+    std::sort(starts.begin(), starts.end(),
+              [](const Start& x, const Start& y) { return x.t < y.t; });
+    ASSERT_GE(starts.size(), 3u) << t.file;
+    for (size_t k = 1; k < starts.size(); ++k) {
+      EXPECT_NE(starts[k].side, starts[k - 1].side) << t.file << " contact start " << starts[k].t;
+    }
+  }
+}
+
 TEST(FootMetrics, SlideOfAKnownTrack) {
   // A foot down for 10 frames at 60 Hz creeping 1 mm per frame along x, then lifted 10 cm:
   // slide 6 cm/s on each of the 9 contact pairs, one interval of 9 mm drift.
