@@ -6,6 +6,7 @@
 
 #include "animation/foot_metrics.h"
 #include "animation/pose_jobs.h"
+#include "common/stats.h"
 
 namespace gk {
 namespace {
@@ -208,13 +209,6 @@ glm::vec3 track_velocity(const std::vector<glm::vec3>& p, const Tracks& tr, int 
   return v;
 }
 
-float percentile_of(std::vector<float> v, float q) {
-  if (v.empty()) return 0.0f;
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<float>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 // Travel velocity of an in-place clip: its stance foot slides backward under the hips at it. The
 // stance foot is the lower one on most frames of any gait, so the median over frames of the lower
 // foot's velocity (relative to the hips) is minus the travel velocity.
@@ -227,7 +221,7 @@ glm::vec3 in_place_travel(const Tracks& tr, const Clip& clip) {
   for (int s = 0; s < 2; ++s) {
     std::vector<float> h(n);
     for (int f = 0; f < n; ++f) h[f] = tr.toe[s][f].y;
-    low[s] = percentile_of(h, 0.05f);
+    low[s] = percentile(h, 0.05f);
   }
   for (int f = 0; f < n; ++f) {
     const int s = tr.toe[1][f].y - low[1] < tr.toe[0][f].y - low[0] ? 1 : 0;
@@ -235,11 +229,7 @@ glm::vec3 in_place_travel(const Tracks& tr, const Clip& clip) {
     vx.push_back(v.x);
     vz.push_back(v.z);
   }
-  auto median = [](std::vector<float>& v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
-  glm::vec3 travel(-median(vx), 0.0f, -median(vz));
+  glm::vec3 travel(-percentile(vx, 0.5), 0.0f, -percentile(vz, 0.5));
   if (glm::length(travel) < kInPlaceSpeed) travel = glm::vec3(0.0f);
   return travel;
 }
@@ -272,7 +262,7 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
       if (a.in_place) v += travel_vel;
       speed[f] = glm::length(v);
     }
-    const float low = percentile_of(h, 0.05f), high = percentile_of(h, 0.95f);
+    const float low = percentile(h, 0.05f), high = percentile(h, 0.95f);
     const float gate = low + std::max(th.min_height_gate_m, th.height_gate_fraction * (high - low));
     down[j].assign(n, 0);
     for (int f = 0; f < n; ++f) down[j][f] = (speed[f] < still || backward[f]) && h[f] <= gate;

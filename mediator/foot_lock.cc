@@ -14,12 +14,6 @@ namespace {
 // Share of a re-planting step spent lifting the foot before it moves (and setting it down after).
 constexpr float kStepLift = 0.2f;
 
-// 0 -> 1 with zero slope at both ends.
-float smoothstep01(float x) {
-  x = std::clamp(x, 0.0f, 1.0f);
-  return x * x * (3.0f - 2.0f * x);
-}
-
 // Decays an inertialization offset toward zero (Holden's decay spring: exact for any dt).
 void decay_offset(glm::vec3& x, glm::vec3& v, float halflife_s, float dt) {
   critical_spring(x, v, glm::vec3(0.0f), halflife_s, dt);

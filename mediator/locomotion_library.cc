@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "animation/pose_jobs.h"
+#include "common/stats.h"
 #include "mediator/springs.h"
 
 namespace gk {
@@ -143,6 +144,44 @@ bool build_phase_table(LocomotionClip* lc) {
   return lc->cycle_s > 0.0f;
 }
 
+// Per frame, whether clip analysis has this foot in contact (`all_if_none`: every frame when the
+// foot has no contact at all, as in a synthesised standing clip).
+std::vector<uint8_t> contact_frames(const ClipAnalysis& a, int side, int n, float fps,
+                                    bool all_if_none) {
+  std::vector<uint8_t> down(n, all_if_none && a.contacts[side].empty() ? 1 : 0);
+  for (const TimeInterval& iv : a.contacts[side]) {
+    const int first = static_cast<int>(std::lround(iv.start_s * fps));
+    const int last = static_cast<int>(std::lround(iv.end_s * fps));
+    for (int f = first; f <= last; ++f) down[((f % n) + n) % n] = 1;
+  }
+  return down;
+}
+
+// The runs of frames between two contacts of a foot, as (first frame, length); a loop's run across
+// its end continues at its start (first + k taken modulo the frame count). A take's runs cut by
+// its first or last frame count as well.
+std::vector<std::pair<int, int>> swing_runs(const std::vector<uint8_t>& down, bool loops) {
+  const int n = static_cast<int>(down.size());
+  std::vector<std::pair<int, int>> runs;
+  int start = 0;
+  if (loops) {  // start the scan on a contact frame so no run is split by the wrap
+    while (start < n && !down[start]) ++start;
+    if (start == n) return {{0, n}};
+  }
+  for (int k = 0; k < n;) {
+    const int f = (start + k) % n;
+    if (down[f]) {
+      ++k;
+      continue;
+    }
+    int len = 0;
+    while (k + len < n && !down[(start + k + len) % n]) ++len;
+    runs.emplace_back(f, len);
+    k += len;
+  }
+  return runs;
+}
+
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
   const Clip& c = lc->clip;
   const int n = c.num_frames;
@@ -170,11 +209,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     lc->toe_floor_m[s] = min_t;
     lc->ankle_floor_m[s] = min_a;
     // A lock may start where clip analysis has the foot in contact.
-    for (const TimeInterval& iv : lc->analysis.contacts[s]) {
-      const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
-      const int b = static_cast<int>(std::lround(iv.end_s * c.fps));
-      for (int f = a; f <= b; ++f) lc->plant[s][((f % n) + n) % n] = 1;
-    }
+    lc->plant[s] = contact_frames(lc->analysis, s, n, c.fps, false);
     // It is kept while the ball of the foot still bears weight: no higher above the ground, and
     // no faster over it, than it ever is in this clip's own contacts (the heel may rise: the foot
     // pivots on the ball at heel-off).
@@ -194,27 +229,11 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     }
     if (contact_h.empty()) continue;
     // The 90th percentile, not the maximum: one jittery capture frame must not hold a swing.
-    auto p90 = [](std::vector<float>& v) {
-      const size_t k = (v.size() * 9) / 10;
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-      return v[std::min(k, v.size() - 1)];
-    };
-    const float max_h = p90(contact_h), max_v = p90(contact_v);
-    // Swing progress between the end of one contact and the start of the next (wrapping a loop).
+    const float max_h = percentile(std::move(contact_h), 0.9), max_v = percentile(contact_v, 0.9);
+    // Swing progress between the end of one contact and the start of the next.
     lc->swing_progress[s].assign(n, 0.0f);
-    for (int f = 0; f < n; ++f) {
-      if (lc->plant[s][f]) continue;
-      int back = 0, ahead = 0;
-      while (back < n &&
-             !lc->plant[s][c.loops ? ((f - back - 1) % n + n) % n : std::max(f - back - 1, 0)] &&
-             (c.loops || f - back - 1 >= 0)) {
-        ++back;
-      }
-      while (ahead < n && (c.loops || f + ahead + 1 < n) &&
-             !lc->plant[s][c.loops ? (f + ahead + 1) % n : std::min(f + ahead + 1, n - 1)]) {
-        ++ahead;
-      }
-      lc->swing_progress[s][f] = (back + 0.5f) / static_cast<float>(back + ahead + 1);
+    for (const auto& [first, len] : swing_runs(lc->plant[s], c.loops)) {
+      for (int k = 0; k < len; ++k) lc->swing_progress[s][(first + k) % n] = (k + 0.5f) / len;
     }
     for (int f = 0; f < n; ++f) {
       lc->hold[s][f] = lc->plant[s][f] || (lc->toe_height_m[s][f] <= max_h && speed[f] <= max_v);
@@ -250,16 +269,9 @@ struct ContactHeights {
 void add_contact_heights(const LocomotionClip& lc, const Skeleton& sk, ContactHeights* out) {
   const Clip& c = lc.clip;
   std::vector<glm::mat4> model(sk.num_joints());
-  std::vector<uint8_t> contact[2];
-  for (int s = 0; s < 2; ++s) {
-    contact[s].assign(c.num_frames, lc.analysis.contacts[s].empty() ? 1 : 0);
-    for (const TimeInterval& iv : lc.analysis.contacts[s]) {
-      const int a = static_cast<int>(std::lround(iv.start_s * c.fps));
-      const int b = static_cast<int>(std::lround(iv.end_s * c.fps));
-      for (int f = a; f <= b; ++f)
-        contact[s][((f % c.num_frames) + c.num_frames) % c.num_frames] = 1;
-    }
-  }
+  const std::vector<uint8_t> contact[2] = {
+      contact_frames(lc.analysis, 0, c.num_frames, c.fps, true),
+      contact_frames(lc.analysis, 1, c.num_frames, c.fps, true)};
   for (int f = 0; f < c.num_frames; ++f) {
     if (!contact[0][f] && !contact[1][f]) continue;
     frame_model(c, sk, f, model);
@@ -269,20 +281,6 @@ void add_contact_heights(const LocomotionClip& lc, const Skeleton& sk, ContactHe
       out->ankle[s].push_back(model[sk.ankle(static_cast<Side>(s))][3].y);
     }
   }
-}
-
-float median(std::vector<float> v) {
-  if (v.empty()) return 0.0f;
-  const size_t k = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-float percentile(std::vector<float> v, float q) {
-  if (v.empty()) return 0.0f;
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<float>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
 }
 
 // Where a clip puts a flat foot's toe: a low percentile of its toe heights over its contact frames
@@ -298,9 +296,11 @@ float flat_toe_height(const LocomotionClip& lc, const Skeleton& sk) {
 
 // Moves a clip up or down by dy [m] (the root joint's translation), keeping everything else.
 void raise_clip(LocomotionClip* lc, float dy) {
-  Clip& c = lc->clip;
-  for (int f = 0; f < c.num_frames; ++f)
-    c.translations[static_cast<size_t>(f) * c.num_joints].y += dy;
+  for (Clip* c : {&lc->clip, &lc->source}) {  // the take as captured stands on the same floor
+    for (int f = 0; f < c->num_frames; ++f) {
+      c->translations[static_cast<size_t>(f) * c->num_joints].y += dy;
+    }
+  }
 }
 
 // A standing clip taken from the frame of a gait clip where both feet are planted closest
@@ -582,7 +582,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       planted[i] = flat_toe_height(lib.clips[i], sk);
       if (lib.clips[i].gait) gait_planted.push_back(planted[i]);
     }
-    const float common = median(gait_planted);
+    const float common = percentile(std::move(gait_planted), 0.5);
     for (size_t i = 0; i < lib.clips.size(); ++i) {
       LocomotionClip& c = lib.clips[i];
       if (std::abs(common - planted[i]) < 1e-6f) continue;
@@ -602,37 +602,27 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       if (c.gait) add_contact_heights(c, sk, &h);
     }
     for (int s = 0; s < 2; ++s) {
-      lib.planted_toe_m[s] = median(h.toe[s]);
-      lib.planted_ankle_m[s] = median(h.ankle[s]);
+      lib.planted_toe_m[s] = percentile(h.toe[s], 0.5);
+      lib.planted_ankle_m[s] = percentile(h.ankle[s], 0.5);
     }
     // The METRICS.md floor is the median height of planted toes, which roll onto heel and ball
     // above a flat foot: the feet are drawn this much higher so a flat foot stands on that floor.
     lib.ground_lift_m =
         std::max(0.0f, 0.5f * (lib.planted_toe_m[0] + lib.planted_toe_m[1]) - common);
     // Swing height: the peak toe height of every swing (between two contacts) of the slowest
-    // forward clip.
+    // forward clip (toe_height_m is above the clip's lowest toe, toe_floor_m).
     const LocomotionClip& slow = lib.clips[lib.groups[lib.forward_group].clips.front()];
     std::vector<float> peaks;
-    std::vector<glm::mat4> model(sk.num_joints());
     for (int s = 0; s < 2; ++s) {
-      const auto& iv = slow.analysis.contacts[s];
       const int nf = slow.clip.num_frames;
-      const size_t swings = slow.clip.loops ? iv.size() : (iv.empty() ? 0 : iv.size() - 1);
-      for (size_t k = 0; k < swings; ++k) {
-        const bool wraps = k + 1 == iv.size();
-        const int a = static_cast<int>(std::lround(iv[k].end_s * slow.clip.fps));
-        const int b = static_cast<int>(std::lround(iv[wraps ? 0 : k + 1].start_s * slow.clip.fps)) +
-                      (wraps ? nf : 0);
-        float peak = -1e9f;
-        for (int g = a; g <= b; ++g) {
-          const int f = slow.clip.loops ? ((g % nf) + nf) % nf : std::clamp(g, 0, nf - 1);
-          frame_model(slow.clip, sk, f, model);
-          peak = std::max(peak, model[sk.toe(static_cast<Side>(s))][3].y - lib.planted_toe_m[s]);
-        }
+      for (const auto& [first, len] : swing_runs(slow.plant[s], slow.clip.loops)) {
+        float peak = 0.0f;
+        for (int k = 0; k < len; ++k) peak = std::max(peak, slow.toe_height_m[s][(first + k) % nf]);
+        peak += slow.toe_floor_m[s] - lib.planted_toe_m[s];
         if (peak > 0.0f) peaks.push_back(peak);
       }
     }
-    if (!peaks.empty()) lib.swing_height_m = median(peaks);
+    if (!peaks.empty()) lib.swing_height_m = percentile(std::move(peaks), 0.5);
   }
   for (int s = 0; s < 2; ++s) {
     lib.toe_floor_m[s] = 1e9f;

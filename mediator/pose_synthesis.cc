@@ -26,12 +26,6 @@ glm::mat4 root_placement(const glm::vec2& xz, float yaw) {
 
 glm::quat rotation_of(const glm::mat4& m) { return glm::normalize(glm::quat_cast(glm::mat3(m))); }
 
-// 0 -> 1 with zero slope at both ends.
-float smoothstep01(float x) {
-  x = std::clamp(x, 0.0f, 1.0f);
-  return x * x * (3.0f - 2.0f * x);
-}
-
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
 // kMaxDrop, on a critically damped spring of halflife kDropHalflife (no vertical snap).
 constexpr float kDropReach = 0.99f;
@@ -62,10 +56,9 @@ float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle_floor)
   return std::clamp(want - now, 0.0f, heel_room(d));
 }
 
-// Returns the pitch [rad].
 // The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
 // about the ball, as far as heel_room allows (bisection; the distance shrinks as the heel rises
-// toward the hip).
+// toward the hip). Returns the pitch [rad].
 float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
                      float limit) {
   const glm::vec3 d = ankle - toe;
@@ -183,14 +176,13 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
     // over the stride's last fifth the pose one stride earlier is blended in, and the wrap to the
     // stride's start joins exactly.
     float seam = 0.0f;
-    if (lc.gait && !lc.clip.loops) {
-      const float t0 = lc.phase_to_time[0], t1 = lc.phase_to_time[kPhaseTableSize];
-      const float u = (time - t0) / std::max(t1 - t0, 1e-4f);
-      seam = time - (t1 - t0) >= 0.0f ? smoothstep01((u - 0.8f) / 0.2f) : 0.0f;
+    if (lc.gait && !lc.clip.loops && time >= lc.cycle_s) {
+      const float u = (time - lc.phase_to_time[0]) / std::max(lc.cycle_s, 1e-4f);
+      seam = smoothstep01((u - 0.8f) / 0.2f);
     }
     layers[num_layers++] = {r, t, w * (1.0f - seam)};
     if (seam > 0.0f) {
-      const float earlier = time - (lc.phase_to_time[kPhaseTableSize] - lc.phase_to_time[0]);
+      const float earlier = time - lc.cycle_s;
       std::span<glm::quat> r2(s.rot.data() + num_layers * J, J);
       std::span<glm::vec3> t2(s.trans.data() + num_layers * J, J);
       SampleClipJob{&lc.clip, earlier, r2, t2}.run();
@@ -282,8 +274,7 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     // it fades in and out with the blend.
     anim_toe[side] = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
     const float lost = pl.gait_toe_y[side][slot] + root[3].y - anim_toe[side].y;
-    const float walking = std::clamp(2.0f * pl.gait_weight[slot], 0.0f, 1.0f);
-    anim_toe[side].y += std::max(0.0f, lost) * walking * walking * (3.0f - 2.0f * walking);
+    anim_toe[side].y += std::max(0.0f, lost) * smoothstep01(2.0f * pl.gait_weight[slot]);
     FootLockInput in;
     in.anim_toe = anim_toe[side];
     in.anim_toe_prev = locks_.anim_toe[k];

@@ -24,6 +24,12 @@ inline void critical_spring(T& x, T& v, const T& goal, float halflife_s, float d
   v = eydt * (v - j1 * y * dt);
 }
 
+// 0 -> 1 with zero slope at both ends (x clamped to [0, 1]).
+inline float smoothstep01(float x) {
+  x = x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);
+  return x * x * (3.0f - 2.0f * x);
+}
+
 inline float wrap_pi(float a) {
   constexpr float kPi = std::numbers::pi_v<float>;
   a = std::fmod(a + kPi, 2.0f * kPi);

@@ -7,17 +7,10 @@
 #include <glm/vec3.hpp>
 
 #include "animation/pose_jobs.h"
+#include "common/stats.h"
 
 namespace gk {
 namespace {
-
-// Nearest-rank percentile q in [0, 1] of v (reorders v); 0 for no samples.
-float percentile(std::vector<float>& v, double q) {
-  if (v.empty()) return 0.0f;
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(std::ceil(q * v.size())) - 1);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
 
 int joint_index(const Skeleton& sk, LimbJoint j, Side s) {
   switch (j) {
@@ -201,16 +194,14 @@ ViewerFeetStats ViewerFeetAccumulator::finish() const {
     double sum = 0.0;
     for (float v : support_cm_s_) sum += v;
     r.support_slide_cm_s = sum / support_cm_s_.size();
-    std::vector<float> copy = support_cm_s_;
-    r.support_slide_p95_cm_s = percentile(copy, 0.95);
+    r.support_slide_p95_cm_s = percentile(support_cm_s_, 0.95);
     r.support_skate_ratio = static_cast<double>(support_skates_) / support_cm_s_.size();
   }
   r.float_samples = float_samples_;
   if (float_samples_) r.float_ratio = static_cast<double>(float_frames_) / float_samples_;
   r.penetration_samples = static_cast<int64_t>(depth_cm_.size());
   if (!depth_cm_.empty()) {
-    std::vector<float> copy = depth_cm_;
-    r.penetration_p99_cm = percentile(copy, 0.99);
+    r.penetration_p99_cm = percentile(depth_cm_, 0.99);
     r.penetration_max_cm = *std::max_element(depth_cm_.begin(), depth_cm_.end());
     r.penetration_ratio = static_cast<double>(deep_) / depth_cm_.size();
   }
