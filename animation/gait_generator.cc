@@ -93,8 +93,8 @@ class GaitPlanner {
     if (idle() || side_step()) return {{0.0f, 0.0f}, {0.5f, 0.0f}};
     const float b = beta();
     const float swing_extra = running() ? 25.0f : 10.0f;
-    // The heel rises slowly at first, so that the ankle stays in its contact band into the double
-    // support, then quickly through push-off.
+    // GAIT.md: the heel lifts while the ball stays planted; the ankle plantarflexes mostly in
+    // pre-swing (push-off), so the heel rises slowly at first and quickly through push-off.
     const float late =
         running() ? heel_off_phase() + 0.8f * (b - heel_off_phase()) : 0.5f + 0.5f * (b - 0.5f);
     return {{0.0f, deg(p_.heel_strike_deg)},
@@ -105,16 +105,18 @@ class GaitPlanner {
             {b + 0.25f * (1.0f - b), -deg(p_.toe_off_deg + swing_extra)},
             {b + 0.75f * (1.0f - b), deg(0.3f * p_.heel_strike_deg)}};
   }
-  // Ball height above its stance height over the swing; the quick initial lift clears the contact
-  // band of METRICS.md before the foot starts to travel.
+  // Ball height above its stance height over the swing. The foot leaves the ground pitched up by
+  // the toe-off angle about its toe tip, so the ball starts the swing as high as that pitch puts
+  // it (toe length x sin(toe-off)) and quickly, before the foot travels; likewise the last few
+  // percent of the swing only lower the foot onto its landing height: it arrives from above.
   std::vector<std::pair<float, float>> make_swing_keys() const {
     const float land = landing_ball_height() - rig_.foot[0].ball_height_m;
-    // Likewise the last few percent of the swing only lower the foot: it arrives from above.
+    const float off = rig_.foot[0].toe_length_m * std::sin(deg(p_.toe_off_deg));
     return {{0.0f, 0.0f},
-            {0.07f, std::min(0.03f, p_.swing_peak_m)},
+            {0.07f, std::min(off, p_.swing_peak_m)},
             {0.3f, p_.swing_peak_m},
-            {0.65f, std::max(p_.swing_mid_m, land + 0.03f)},
-            {0.94f, std::max(land, 0.03f)},
+            {0.65f, std::max(p_.swing_mid_m, land + off)},
+            {0.94f, std::max(land, off)},
             {1.0f, land}};
   }
 

@@ -132,7 +132,9 @@ void DemoApp::panel_view() {
   help_marker("White crosses: feet locked in world space by two-bone IK");
   ImGui::SameLine();
   ImGui::Checkbox("foot trails", &overlays_.trails);
-  help_marker("Toe positions while on the ground: green = still, red = sliding >= 30 cm/s");
+  help_marker(
+      "Support-foot toe within 5 cm of the clips' floor (METRICS.md v2): green = still, red = "
+      "sliding >= 30 cm/s");
   ImGui::SameLine();
   ImGui::Checkbox("paths", &overlays_.paths);
   help_marker("Root path of the last 4 s");

@@ -1,8 +1,9 @@
 #pragma once
 // METRICS.md v2, "What a viewer sees of the feet": the feet measured against the floor the clips
-// were authored on, with no contact band of the foot's own to step out of. One accumulator serves
-// the crowd (MetricsRecorder) and the library's own clips played with their root motion (the
-// floor every figure is reported beside).
+// were authored on. The constants below are that document's definitions (a measurement, not a
+// motion parameter: no motion code reads them). One accumulator serves the crowd
+// (MetricsRecorder) and the library's own clips played with their root motion (the floor every
+// figure is reported beside).
 
 #include <array>
 #include <cstdint>
@@ -65,8 +66,9 @@ struct ViewerFeetStats {
 
 class ViewerFeetAccumulator {
  public:
-  static constexpr float kNearFloorM = 0.05f;         // "within 5 cm of its floor height"
-  static constexpr float kSkateCmS = 30.0f;           // support skate threshold
+  // METRICS.md v2 definitions:
+  static constexpr float kNearFloorM = 0.05f;         // [m] "within 5 cm of its floor height"
+  static constexpr float kSkateCmS = 30.0f;           // [cm/s] support samples counted as skating
   static constexpr float kFloatMinSpeed = 0.1f;       // [m/s] walking, no flight phase
   static constexpr float kFloatMaxSpeed = 2.2f;       // [m/s]
   static constexpr float kPenetrationCountM = 0.01f;  // ratio counts feet deeper than this
