@@ -6,9 +6,10 @@
 // it, then released: the difference between where it was drawn and where the clip has it becomes
 // an offset that the foot sheds over the clips' own swing (smoothly in the swing's progress, gone
 // when the clip lands the foot), so no joint snaps, the correction happens in the air, and the
-// swing keeps the clip's own height. A foot that lands settles onto
-// the floor through a decaying offset (a critically damped spring, exact for any step). A standing
-// foot left far behind re-plants with a short step as high as the clips' own swing.
+// swing keeps the clip's own height. A foot that lands settles onto the floor through a decaying
+// offset (a critically damped spring, exact for any step). A pinned foot left far behind by a turn
+// or a drift re-plants, while the other foot is pinned, with a short step as high as the clips'
+// own swing.
 
 #include <cstdint>
 
@@ -44,7 +45,6 @@ struct FootLockInput {
   bool plant = false;              // the clips put this foot on the ground (a lock may start)
   bool hold = false;               // the clips still have weight on it (a lock is kept)
   float swing_progress = 0.0f;     // the clips' swing of this foot, 0 at lift-off, 1 at landing
-  bool standing = false;           // the agent stands (re-planting steps instead of strides)
   bool other_locked = false;       // the other foot is pinned (one foot steps at a time)
   float floor_toe_m = 0.0f;        // where planted toes are (library floor) [m]
 };

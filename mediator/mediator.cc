@@ -387,8 +387,6 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   // clip's "both feet down" would otherwise keep a stepping foot locked while it swings.
   float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
   float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f};
-  float lead_w = 0.0f;
-  uint8_t lead_plant[2] = {0, 0};
   const bool gait_votes = gait_w >= 0.25f;
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     const LocomotionClip& clip = lib.clips[lc[k]];
@@ -396,15 +394,14 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
                       : std::fmod(idle_time_[slot], std::max(clip.clip.duration_s(), 1e-3f));
     if (lw[k] <= 0.0f) continue;
     const int nf = clip.clip.num_frames;
-    int f = static_cast<int>(std::lround(lt[k] * clip.clip.fps));
-    f = clip.clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
-    // Toe heights between frames (a 24 or 30 fps clip must not step the foot every other frame).
-    const float ft = lt[k] * clip.clip.fps;
-    const int f0 = static_cast<int>(std::floor(ft));
-    const float fu = ft - static_cast<float>(f0);
     auto wrap = [&](int i) {
       return clip.clip.loops ? ((i % nf) + nf) % nf : std::clamp(i, 0, nf - 1);
     };
+    const float ft = lt[k] * clip.clip.fps;
+    const int f = wrap(static_cast<int>(std::lround(ft)));
+    // Toe heights between frames (a 24 or 30 fps clip must not step the foot every other frame).
+    const int f0 = static_cast<int>(std::floor(ft));
+    const float fu = ft - static_cast<float>(f0);
     for (int s = 0; s < 2; ++s) {
       if (clip.gait && !clip.toe_height_m[s].empty()) {
         const auto& h = clip.toe_height_m[s];
@@ -414,10 +411,6 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     }
     if (gait_votes && !clip.gait) continue;
     vote_w += lw[k];
-    if (lw[k] > lead_w) {
-      lead_w = lw[k];
-      for (int s = 0; s < 2; ++s) lead_plant[s] = clip.plant[s][f];
-    }
     for (int s = 0; s < 2; ++s) {
       plant[s] += lw[k] * clip.plant[s][f];
       if (!clip.swing_progress[s].empty()) swing[s] += lw[k] * clip.swing_progress[s][f];
@@ -427,14 +420,6 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   for (int s = 0; s < 2; ++s) {
     plant[s] /= std::max(vote_w, 1e-6f);
     hold[s] /= std::max(vote_w, 1e-6f);
-  }
-  // Clips blended out of step (a walk with a strafe) can split the vote so that neither foot has
-  // a majority although each clip stands on one: then the clip with the largest weight decides,
-  // so the body is never left without the foot its leading clip stands on.
-  if (plant[0] < 0.5f && plant[1] < 0.5f && (lead_plant[0] || lead_plant[1])) {
-    for (int s = 0; s < 2; ++s) {
-      if (lead_plant[s]) plant[s] = hold[s] = std::max(hold[s], 0.5f);
-    }
   }
   // 8. Feedback: the speed and torso orientation the animation can deliver.
   const int a = agent;

@@ -283,7 +283,6 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     in.plant = pl.plant[side][slot] >= 0.5f;
     in.hold = pl.hold[side][slot] >= 0.5f;
     in.swing_progress = pl.swing_progress[side][slot];
-    in.standing = pl.standing[slot] != 0;
     in.other_locked =
         locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
     in.floor_toe_m = library_.planted_toe_m[side];

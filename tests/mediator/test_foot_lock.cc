@@ -272,7 +272,6 @@ TEST(FootLock, GoalIsNeverNaN) {
       in.plant = unit(rng) < 0.3f;
       in.hold = unit(rng) < 0.6f;
       in.swing_progress = -0.5f + 2.0f * unit(rng);
-      in.standing = unit(rng) < 0.5f;
       in.other_locked = unit(rng) < 0.5f;
       in.floor_toe_m = 0.2f * (unit(rng) - 0.5f);
       if (unit(rng) < 0.03f) start_foot_step(lock, goal);
