@@ -270,6 +270,56 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
   for (int f = 0; f < n; ++f) (*out)[f] = down[0][f] || down[1][f];
 }
 
+// In a walk or a run the feet take turns: between two contacts of one foot the other foot lands.
+// Two contacts of a foot with no landing of the other between them, parted by a gap shorter than
+// half the foot's typical contact (a swing takes longer than that in any gait), are one contact
+// broken by a jittery frame or a slipping capture: joined.
+void merge_unalternated(std::vector<TimeInterval> contacts[2], float duration_s, bool loops) {
+  std::vector<TimeInterval> merged[2];
+  for (int s = 0; s < 2; ++s) {
+    std::vector<TimeInterval>& mine = contacts[s];
+    const std::vector<TimeInterval>& other = contacts[1 - s];
+    if (mine.size() < 2 || other.empty()) {
+      merged[s] = mine;
+      continue;
+    }
+    std::vector<float> lengths;
+    for (const TimeInterval& c : mine) lengths.push_back(c.end_s - c.start_s);
+    const float typical = 0.5f * percentile(lengths, 0.5);
+    auto lands_between = [&](float from, float to) {
+      for (const TimeInterval& o : other) {
+        for (float shift : {0.0f, loops ? duration_s : 0.0f, loops ? -duration_s : 0.0f}) {
+          const float t = o.start_s + shift;
+          if (t > from && t < to) return true;
+        }
+      }
+      return false;
+    };
+    std::vector<TimeInterval> out{mine[0]};
+    for (size_t i = 1; i < mine.size(); ++i) {
+      TimeInterval& last = out.back();
+      if (mine[i].start_s - last.end_s < typical && !lands_between(last.start_s, mine[i].start_s)) {
+        last.end_s = std::max(last.end_s, mine[i].end_s);
+      } else {
+        out.push_back(mine[i]);
+      }
+    }
+    // A loop's last contact may run into its first across the wrap.
+    if (loops && out.size() >= 2) {
+      const TimeInterval& first = out.front();
+      const TimeInterval& last = out.back();
+      const float gap = first.start_s + duration_s - last.end_s;
+      if (gap >= 0.0f && gap < typical && !lands_between(last.start_s, first.start_s + duration_s)) {
+        out.back().end_s = first.end_s + duration_s;
+        out.erase(out.begin());
+      }
+    }
+    merged[s] = std::move(out);
+  }
+  contacts[0] = std::move(merged[0]);
+  contacts[1] = std::move(merged[1]);
+}
+
 }  // namespace
 
 ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThresholds& th) {
@@ -313,6 +363,7 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
                 clip.loops);
     a.contacts[s] = to_intervals(contact[s], clip.fps, clip.loops);
   }
+  merge_unalternated(a.contacts, a.duration_s, clip.loops);
 
   a.native_speed_m_s = glm::length(travel_vel);
   a.direction_rad =

@@ -15,6 +15,7 @@
 #include "animation/analysis.h"
 #include "animation/clip_library.h"
 #include "animation/procedural.h"
+#include "animation/segmentation.h"
 #include "app/commands.h"
 
 namespace gk::app {
@@ -32,8 +33,42 @@ nlohmann::json intervals_json(const std::vector<TimeInterval>& v) {
   return out;
 }
 
-nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAnalysis& a) {
+constexpr float kDeg = 180.0f / std::numbers::pi_v<float>;
+
+nlohmann::json segmentation_json(const TakeSegmentation& seg) {
+  nlohmann::json strides = nlohmann::json::array();
+  for (const Stride& st : seg.strides) {
+    strides.push_back({{"start_s", st.span.start_s},
+                       {"end_s", st.span.end_s},
+                       {"foot", st.side == 0 ? "left" : "right"},
+                       {"speed_m_s", st.speed_m_s},
+                       {"speed_change", st.speed_change},
+                       {"turn_deg", st.turn_rad * kDeg},
+                       {"direction_deg", st.direction_rad * kDeg},
+                       {"steady", st.steady}});
+  }
+  nlohmann::json segments = nlohmann::json::array();
+  for (const TakeSegment& s : seg.segments) {
+    nlohmann::json j = {{"kind", segment_kind_name(s.kind)},
+                        {"start_s", s.span.start_s},
+                        {"end_s", s.span.end_s},
+                        {"speed_m_s", s.speed_m_s},
+                        {"speed_in_m_s", s.speed_in_m_s},
+                        {"speed_out_m_s", s.speed_out_m_s},
+                        {"turn_deg", s.turn_rad * kDeg}};
+    if (s.cycle >= 0) j["cycle_stride"] = s.cycle;
+    segments.push_back(std::move(j));
+  }
+  return {{"strides", strides},
+          {"segments", segments},
+          {"cycles", seg.cycles},
+          {"problems", seg.problems}};
+}
+
+nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAnalysis& a,
+                             const TakeSegmentation& seg) {
   return {
+      {"take", segmentation_json(seg)},
       {"file", set.source},
       {"name", clip.name},
       {"frames", clip.num_frames},
@@ -80,6 +115,38 @@ void print_text(const nlohmann::json& j) {
               j["foot_slide_floor_cm_s"].get<double>(),
               j["foot_slide_floor_p95_cm_s"].get<double>(), j["skate_ratio_floor"].get<double>(),
               j["foot_drift_floor_cm_per_step"].get<double>());
+  const nlohmann::json& take = j["take"];
+  const nlohmann::json& strides = take["strides"];
+  for (const auto& s : take["segments"]) {
+    std::printf("  segment %-10s %6.3f-%6.3f s  speed %.2f m/s (%.2f -> %.2f), turn %+.0f deg",
+                s["kind"].get<std::string>().c_str(), s["start_s"].get<double>(),
+                s["end_s"].get<double>(), s["speed_m_s"].get<double>(),
+                s["speed_in_m_s"].get<double>(), s["speed_out_m_s"].get<double>(),
+                s["turn_deg"].get<double>());
+    if (s.contains("cycle_stride")) {
+      const auto& st = strides[s["cycle_stride"].get<size_t>()];
+      std::printf("  -> loop %.3f-%.3f s (%.2f m/s, direction %+.0f deg)",
+                  st["start_s"].get<double>(), st["end_s"].get<double>(),
+                  st["speed_m_s"].get<double>(), st["direction_deg"].get<double>());
+    }
+    std::printf("\n");
+  }
+  int steady = 0;
+  for (const auto& st : strides) steady += st["steady"].get<bool>();
+  std::printf("  strides %zu (%d steady)\n", strides.size(), steady);
+  for (const auto& l : take["loops"]) {
+    std::printf("  loop of stride %d: %d frames, %.3f m/s, direction %+.1f deg, foot-slide floor %.2f cm/s\n",
+                l["stride"].get<int>(), l["frames"].get<int>(), l["speed_m_s"].get<double>(),
+                l["direction_deg"].get<double>(), l["foot_slide_floor_cm_s"].get<double>());
+    for (const char* side : {"left", "right"}) {
+      std::printf("    contacts %-5s:", side);
+      for (const auto& c : l["contacts"][side]) {
+        std::printf(" [%.3f, %.3f]", c[0].get<double>(), c[1].get<double>());
+      }
+      std::printf("\n");
+    }
+  }
+  for (const auto& p : take["problems"]) std::printf("  problem: %s\n", p.get<std::string>().c_str());
 }
 
 int run_analyze(const AnalyzeOptions& opt) {
@@ -127,7 +194,23 @@ int run_analyze(const AnalyzeOptions& opt) {
     }
     for (const Clip& clip : set.clips) {
       const ClipAnalysis a = analyze_clip(clip, *set.skeleton);
-      nlohmann::json j = analysis_json(set, clip, a);
+      const TakeSegmentation seg = segment_take(clip, *set.skeleton, a);
+      nlohmann::json j = analysis_json(set, clip, a, seg);
+      // Each cycle cut out as a loop, analysed as the library will use it.
+      nlohmann::json loops = nlohmann::json::array();
+      for (int ci : seg.cycles) {
+        const Clip loop = extract_cycle(clip, *set.skeleton, a, seg.strides[ci]);
+        const ClipAnalysis la = analyze_clip(loop, *set.skeleton);
+        loops.push_back({{"stride", ci},
+                         {"frames", loop.num_frames},
+                         {"speed_m_s", la.native_speed_m_s},
+                         {"direction_deg", la.direction_rad * kDeg},
+                         {"contacts",
+                          {{"left", intervals_json(la.contacts[0])},
+                           {"right", intervals_json(la.contacts[1])}}},
+                         {"foot_slide_floor_cm_s", la.floor.mean_cm_s}});
+      }
+      j["take"]["loops"] = std::move(loops);
       if (!opt.json) print_text(j);
       all.push_back(std::move(j));
     }

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "animation/pose_jobs.h"
+#include "animation/segmentation.h"
 #include "common/stats.h"
 #include "mediator/springs.h"
 
@@ -489,35 +490,71 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     for (const Clip& original : set.clips) {
       if (name_excluded(original.name) || original.num_frames < 2) continue;
       Clip clip = same ? original : retarget_clip(original, src, sk, dst_leg / src_leg);
-      LocomotionClip lc;
-      lc.analysis = analyze_clip(clip, sk);
-      const float facing = clip_facing(clip, sk);
-      lc.speed_m_s = lc.analysis.native_speed_m_s;
-      lc.direction_rad = lc.analysis.direction_rad;
-      lc.clip = make_in_place(clip, sk, lc.analysis, facing);
-      if (!lc.analysis.in_place) {
-        // The take as captured (root motion kept), on a level floor: the metrics' references.
-        lc.source = clip;
-        for (int f = 0; f < lc.source.num_frames; ++f) {
-          lc.source.translations[static_cast<size_t>(f) * lc.source.num_joints].y -=
-              lc.analysis.ground_slope_m_s * (f / lc.source.fps);
+      // One clip of the library: analysed, made in place, classified as gait or standing.
+      // `take`: the capture it was cut from, on a level floor (the metrics' reference; null for a
+      // clip authored in place or a second cut of the same take).
+      auto add = [&](Clip c, const Clip* take) {
+        LocomotionClip lc;
+        lc.analysis = analyze_clip(c, sk);
+        const float facing = clip_facing(c, sk);
+        lc.speed_m_s = lc.analysis.native_speed_m_s;
+        lc.direction_rad = lc.analysis.direction_rad;
+        lc.clip = make_in_place(c, sk, lc.analysis, facing);
+        if (take != nullptr) lc.source = *take;
+        fill_contacts_and_heights(&lc, sk);
+        const bool both_feet =
+            !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
+        if (lc.speed_m_s < kMinGaitSpeed) {
+          if (both_feet) {
+            lc.cycle_s = lc.clip.duration_s();
+            idles.push_back(std::move(lc));
+          }
+          return;
         }
-      }
-      fill_contacts_and_heights(&lc, sk);
-      const bool both_feet = !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
-      if (lc.speed_m_s < kMinGaitSpeed) {
-        if (both_feet) {
-          lc.cycle_s = lc.clip.duration_s();
-          idles.push_back(std::move(lc));
-        }
+        if (lc.speed_m_s > kMaxGaitSpeed || !both_feet) return;
+        lc.gait = true;
+        lc.cycle_start_s = lc.analysis.contacts[0][0].start_s;
+        if (!lc.clip.loops) lc.cycle_start_s = lc.analysis.cycle.start_s;
+        if (!build_phase_table(&lc)) return;
+        lib.clips.push_back(std::move(lc));
+      };
+      const ClipAnalysis whole = analyze_clip(clip, sk);
+      if (clip.loops || whole.in_place) {
+        const Clip as_captured = clip;
+        add(std::move(clip), whole.in_place ? nullptr : &as_captured);
         continue;
       }
-      if (lc.speed_m_s > kMaxGaitSpeed || !both_feet) continue;
-      lc.gait = true;
-      lc.cycle_start_s = lc.analysis.contacts[0][0].start_s;
-      if (!lc.clip.loops) lc.cycle_start_s = lc.analysis.cycle.start_s;
-      if (!build_phase_table(&lc)) continue;
-      lib.clips.push_back(std::move(lc));
+      // A take with root motion: levelled onto its fitted floor, then cut into its steady cycles
+      // (loops) and its standing stretches (a still pose); starts, stops and turns are reported.
+      for (int f = 0; f < clip.num_frames; ++f) {
+        clip.translations[static_cast<size_t>(f) * clip.num_joints].y -=
+            whole.ground_slope_m_s * (f / clip.fps);
+      }
+      const ClipAnalysis levelled = analyze_clip(clip, sk);
+      const TakeSegmentation seg = segment_take(clip, sk, levelled);
+      TakeReport report{clip.name, seg, {}};
+      for (size_t k = 0; k < seg.cycles.size(); ++k) {
+        Clip loop = extract_cycle(clip, sk, levelled, seg.strides[seg.cycles[k]]);
+        if (k > 0) loop.name += " #" + std::to_string(k + 1);
+        report.clips.push_back(loop.name);
+        add(std::move(loop), k == 0 ? &clip : nullptr);
+      }
+      for (const TakeSegment& s : seg.segments) {
+        if (s.kind != SegmentKind::kIdle || s.span.end_s - s.span.start_s < 0.2f) continue;
+        // Standing: the stretch's middle frame held still.
+        const float mid = 0.5f * (s.span.start_s + s.span.end_s);
+        Clip still = extract_span(clip, {mid, mid});
+        still.loops = true;
+        still.rotations.insert(still.rotations.end(), still.rotations.begin(),
+                               still.rotations.end());
+        still.translations.insert(still.translations.end(), still.translations.begin(),
+                                  still.translations.end());
+        still.num_frames = 2;
+        still.name += " (standing)";
+        report.clips.push_back(still.name);
+        add(std::move(still), nullptr);
+      }
+      lib.takes.push_back(std::move(report));
     }
   }
   if (lib.clips.empty()) {

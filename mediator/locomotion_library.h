@@ -11,6 +11,7 @@
 
 #include "animation/analysis.h"
 #include "animation/clip.h"
+#include "animation/segmentation.h"
 #include "animation/mesh.h"
 
 namespace gk {
@@ -43,6 +44,13 @@ struct LocomotionClip {
   float toe_floor_m[2] = {0.0f, 0.0f};     // lowest toe height in the clip
   float ankle_floor_m[2] = {0.0f, 0.0f};   // lowest ankle height in the clip
   float time_at_phase(float phase) const;  // phase in [0, 1)
+};
+
+// What the library made of a take with root motion: its segments and the clips cut from it.
+struct TakeReport {
+  std::string name;
+  TakeSegmentation segmentation;
+  std::vector<std::string> clips;  // names of the library clips cut from it
 };
 
 // Clips of one travel direction, sorted by speed.
@@ -79,6 +87,7 @@ struct LocomotionLibrary {
   // Largest per-frame change of any joint's local rotation over all source clips, resampled to
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;
+  std::vector<TakeReport> takes;  // takes with root motion, as segmented
   std::vector<std::string> clip_names() const;
   bool has_direction_clips() const { return groups.size() > 1; }
 };

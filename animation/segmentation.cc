@@ -1,0 +1,432 @@
+#include "animation/segmentation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "animation/pose_jobs.h"
+
+namespace gk {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+float wrap(float a) {
+  while (a > kPi) a -= 2.0f * kPi;
+  while (a < -kPi) a += 2.0f * kPi;
+  return a;
+}
+
+// Horizontal hips position and facing (perpendicular to the right->left hip line) per frame, the
+// facing unwrapped so that differences over a turn are continuous.
+struct TakeTrack {
+  std::vector<glm::vec2> hips;
+  std::vector<float> facing;
+};
+
+TakeTrack track_take(const Clip& c, const Skeleton& sk) {
+  TakeTrack t;
+  std::vector<glm::mat4> model(sk.num_joints());
+  const int hips = std::max(sk.role(JointRole::kHips), 0);
+  for (int f = 0; f < c.num_frames; ++f) {
+    LocalToModelJob{&sk,
+                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
+                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
+                    glm::mat4(1.0f),
+                    model}
+        .run();
+    const glm::vec3 h = translation_of(model[hips]);
+    t.hips.emplace_back(h.x, h.z);
+    const glm::vec3 lr = translation_of(model[sk.hip(Side::kLeft)]) -
+                         translation_of(model[sk.hip(Side::kRight)]);
+    const glm::vec3 fwd = glm::cross(lr, glm::vec3(0, 1, 0));
+    float yaw = std::atan2(fwd.x, fwd.z);
+    if (f > 0) yaw = t.facing.back() + wrap(yaw - t.facing.back());
+    t.facing.push_back(yaw);
+  }
+  return t;
+}
+
+// Smoothed horizontal root speed per frame: displacement over +-half_s (shortened at the ends).
+std::vector<float> smoothed_speed(const TakeTrack& t, float fps, float half_s) {
+  const int n = static_cast<int>(t.hips.size());
+  const int k = std::max(1, static_cast<int>(std::lround(half_s * fps)));
+  std::vector<float> v(n, 0.0f);
+  for (int f = 0; f < n; ++f) {
+    const int lo = std::max(0, f - k), hi = std::min(n - 1, f + k);
+    if (hi > lo) v[f] = glm::length(t.hips[hi] - t.hips[lo]) * fps / (hi - lo);
+  }
+  return v;
+}
+
+int frame_at(float t_s, float fps, int n) {
+  return std::clamp(static_cast<int>(std::lround(t_s * fps)), 0, n - 1);
+}
+
+float path_length(const TakeTrack& t, int a, int b) {
+  float len = 0.0f;
+  for (int f = a; f < b; ++f) len += glm::length(t.hips[f + 1] - t.hips[f]);
+  return len;
+}
+
+// How well a stride loops: rotation difference of every joint below the root between its first and
+// last frame, plus the root's height difference [rad, with metres counted as 10 rad/m].
+float seam_cost(const Clip& c, int a, int b) {
+  const glm::quat* ra = c.frame_rotations(a);
+  const glm::quat* rb = c.frame_rotations(b);
+  float cost = 0.0f;
+  for (int j = 1; j < c.num_joints; ++j) {
+    cost += 2.0f * std::acos(std::min(1.0f, std::abs(glm::dot(ra[j], rb[j]))));
+  }
+  cost += 10.0f * std::abs(c.frame_translations(a)[0].y - c.frame_translations(b)[0].y);
+  return cost;
+}
+
+// Frames on either side of a take's edge that contact analysis cannot trust: a contact cut by the
+// first frame did not start there.
+bool starts_inside(const TimeInterval& c, float fps) { return c.start_s > 0.5f / fps; }
+
+}  // namespace
+
+const char* segment_kind_name(SegmentKind kind) {
+  switch (kind) {
+    case SegmentKind::kIdle: return "idle";
+    case SegmentKind::kStart: return "start";
+    case SegmentKind::kSteady: return "steady";
+    case SegmentKind::kTurn: return "turn";
+    case SegmentKind::kStop: return "stop";
+    case SegmentKind::kTransition: return "transition";
+  }
+  return "?";
+}
+
+TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAnalysis& a,
+                              const SegmentationThresholds& th) {
+  TakeSegmentation out;
+  const int n = take.num_frames;
+  const float fps = take.fps;
+  if (n < 2) return out;
+  if (take.loops || a.in_place || !sk.has_locomotion_roles()) {
+    TakeSegment whole;
+    whole.kind = a.native_speed_m_s > 0.0f ? SegmentKind::kSteady : SegmentKind::kIdle;
+    whole.span = {0.0f, take.duration_s()};
+    whole.speed_m_s = whole.speed_in_m_s = whole.speed_out_m_s = a.native_speed_m_s;
+    out.segments.push_back(whole);
+    return out;
+  }
+  const TakeTrack tr = track_take(take, sk);
+  const std::vector<float> speed = smoothed_speed(tr, fps, 0.25f);
+
+  // Strides: from each contact start of a foot to its next, with exactly one contact start of the
+  // other foot between them (the feet alternate).
+  for (int s = 0; s < 2; ++s) {
+    const auto& mine = a.contacts[s];
+    const auto& other = a.contacts[1 - s];
+    for (size_t i = 0; i + 1 < mine.size(); ++i) {
+      if (!starts_inside(mine[i], fps)) continue;
+      const float t0 = mine[i].start_s, t1 = mine[i + 1].start_s;
+      const float dur = t1 - t0;
+      if (dur < th.min_stride_s || dur > th.max_stride_s) continue;
+      int between = 0;
+      for (const TimeInterval& o : other) between += o.start_s > t0 && o.start_s < t1;
+      if (between != 1) continue;
+      Stride st;
+      st.span = {t0, t1};
+      st.side = s;
+      const int f0 = frame_at(t0, fps, n), f1 = frame_at(t1, fps, n);
+      const int fm = (f0 + f1) / 2;
+      if (f1 - f0 < 2) continue;
+      const glm::vec2 d = tr.hips[f1] - tr.hips[f0];
+      st.speed_m_s = glm::length(d) * fps / (f1 - f0);
+      const float v1 = glm::length(tr.hips[fm] - tr.hips[f0]) * fps / std::max(1, fm - f0);
+      const float v2 = glm::length(tr.hips[f1] - tr.hips[fm]) * fps / std::max(1, f1 - fm);
+      st.speed_change = st.speed_m_s > 1e-3f ? (v2 - v1) / st.speed_m_s : 0.0f;
+      st.turn_rad = tr.facing[f1] - tr.facing[f0];
+      const float mean_facing = 0.5f * (tr.facing[f0] + tr.facing[f1]);
+      st.direction_rad =
+          st.speed_m_s > 1e-3f ? wrap(std::atan2(d.x, d.y) - mean_facing) : 0.0f;
+      st.steady = std::abs(st.speed_change) < th.steady_speed_change &&
+                  std::abs(st.turn_rad) < th.steady_turn_rad && v1 > th.idle_speed_m_s &&
+                  v2 > th.idle_speed_m_s;
+      out.strides.push_back(st);
+    }
+  }
+  std::sort(out.strides.begin(), out.strides.end(),
+            [](const Stride& x, const Stride& y) { return x.span.start_s < y.span.start_s; });
+
+  // Per-frame labels: steady where a steady stride covers the frame; idle where the root stands;
+  // the rest is told apart per run (start, stop, turn, transition).
+  std::vector<SegmentKind> label(n, SegmentKind::kTransition);
+  std::vector<uint8_t> steady(n, 0);
+  for (const Stride& st : out.strides) {
+    if (!st.steady) continue;
+    for (int f = frame_at(st.span.start_s, fps, n); f <= frame_at(st.span.end_s, fps, n); ++f) {
+      steady[f] = 1;
+    }
+  }
+  for (int f = 0; f < n; ++f) {
+    if (steady[f]) {
+      label[f] = SegmentKind::kSteady;
+    } else if (speed[f] < th.idle_speed_m_s) {
+      label[f] = SegmentKind::kIdle;
+    }
+  }
+  // Runs shorter than min_segment_s join the run before them (or after, at the take's start).
+  const int min_run = std::max(1, static_cast<int>(std::lround(th.min_segment_s * fps)));
+  auto runs = [&] {
+    std::vector<std::pair<int, int>> r;  // [first, last]
+    for (int f = 0; f < n;) {
+      int g = f;
+      while (g + 1 < n && label[g + 1] == label[f]) ++g;
+      r.push_back({f, g});
+      f = g + 1;
+    }
+    return r;
+  };
+  for (int pass = 0; pass < 4; ++pass) {
+    bool changed = false;
+    const auto r = runs();
+    for (size_t i = 0; i < r.size() && r.size() > 1; ++i) {
+      const auto [f, g] = r[i];
+      if (g - f + 1 >= min_run) continue;
+      const SegmentKind into = i > 0 ? label[r[i - 1].second] : label[r[i + 1].first];
+      for (int k = f; k <= g; ++k) label[k] = into;
+      changed = true;
+      break;
+    }
+    if (!changed) break;
+  }
+  // Non-steady, non-idle runs: a turn where the body turns more than a steady stride does, else a
+  // start where the root speeds up, a stop where it slows down, otherwise a transition.
+  for (const auto& [f, g] : runs()) {
+    if (label[f] != SegmentKind::kTransition) continue;
+    const float turn = tr.facing[g] - tr.facing[f];
+    const float s0 = speed[f], s1 = speed[g];
+    const float mean = std::max(0.5f * (s0 + s1), 1e-3f);
+    SegmentKind k = SegmentKind::kTransition;
+    if (std::abs(turn) >= th.steady_turn_rad) {
+      k = SegmentKind::kTurn;
+    } else if ((s1 - s0) / mean >= th.steady_speed_change) {
+      k = SegmentKind::kStart;
+    } else if ((s0 - s1) / mean >= th.steady_speed_change) {
+      k = SegmentKind::kStop;
+    }
+    for (int q = f; q <= g; ++q) label[q] = k;
+  }
+  // A transition beside steady gait that neither starts, stops nor turns is the same gait where no
+  // full stride fits (the take's first and last steps) or where the pace wavers: steady.
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto r = runs();
+    for (size_t i = 0; i < r.size(); ++i) {
+      if (label[r[i].first] != SegmentKind::kTransition) continue;
+      const bool beside = (i > 0 && label[r[i - 1].second] == SegmentKind::kSteady) ||
+                          (i + 1 < r.size() && label[r[i + 1].first] == SegmentKind::kSteady);
+      if (!beside) continue;
+      for (int k = r[i].first; k <= r[i].second; ++k) label[k] = SegmentKind::kSteady;
+    }
+  }
+  for (const auto& [f, g] : runs()) {
+    TakeSegment seg;
+    seg.kind = label[f];
+    // Segments meet: each ends where the next begins.
+    seg.span = {f / fps, (g + 1 < n ? g + 1 : g) / fps};
+    const int last = g + 1 < n ? g + 1 : g;
+    seg.speed_m_s = last > f ? path_length(tr, f, last) * fps / (last - f) : 0.0f;
+    seg.speed_in_m_s = speed[f];
+    seg.speed_out_m_s = speed[last];
+    seg.turn_rad = tr.facing[last] - tr.facing[f];
+    out.segments.push_back(seg);
+  }
+
+  // Cycles: in each steady segment, the stride inside it whose ends match best.
+  for (TakeSegment& seg : out.segments) {
+    if (seg.kind != SegmentKind::kSteady) continue;
+    float best = 1e30f;
+    for (size_t i = 0; i < out.strides.size(); ++i) {
+      const Stride& st = out.strides[i];
+      if (!st.steady || st.span.start_s < seg.span.start_s - 0.5f / fps ||
+          st.span.end_s > seg.span.end_s + 0.5f / fps) {
+        continue;
+      }
+      const float cost =
+          seam_cost(take, frame_at(st.span.start_s, fps, n), frame_at(st.span.end_s, fps, n));
+      if (cost < best) {
+        best = cost;
+        seg.cycle = static_cast<int>(i);
+      }
+    }
+    if (seg.cycle >= 0) out.cycles.push_back(seg.cycle);
+  }
+  if (out.cycles.empty() && !out.strides.empty()) {
+    int least = 0;
+    for (size_t i = 1; i < out.strides.size(); ++i) {
+      const Stride& st = out.strides[i];
+      if (std::abs(st.speed_change) < std::abs(out.strides[least].speed_change)) {
+        least = static_cast<int>(i);
+      }
+    }
+    out.cycles.push_back(least);
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "no steady stride (the body speeds up, slows down or turns in every one): the "
+                  "least unsteady stride, %.2f-%.2f s (speed change %.0f%%), is used as the cycle",
+                  out.strides[least].span.start_s, out.strides[least].span.end_s,
+                  100.0f * out.strides[least].speed_change);
+    out.problems.push_back(buf);
+  }
+  if (out.strides.empty()) {
+    out.problems.push_back(
+        "no full stride (a foot's contact, a contact of the other foot, the first foot's next "
+        "contact): no gait cycle can be cut out");
+  }
+  return out;
+}
+
+Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
+                   const Stride& stride) {
+  const int n = take.num_frames, nj = take.num_joints;
+  const float fps = take.fps;
+  const int a = frame_at(stride.span.start_s, fps, n);
+  const int b = frame_at(stride.span.end_s, fps, n);
+  const int len = std::max(1, b - a);
+  Clip c;
+  c.name = take.name;
+  c.source = take.source;
+  c.fps = fps;
+  c.num_frames = len;
+  c.num_joints = nj;
+  c.loops = true;
+  // Frames a..b: the stride and the frame that closes it (where the loop must come back to).
+  std::vector<glm::quat> rot(take.frame_rotations(a),
+                             take.frame_rotations(a) + static_cast<size_t>(len + 1) * nj);
+  std::vector<glm::vec3> tra(take.frame_translations(a),
+                             take.frame_translations(a) + static_cast<size_t>(len + 1) * nj);
+  auto R = [&](int k, int j) -> glm::quat& { return rot[static_cast<size_t>(k) * nj + j]; };
+  auto T = [&](int k, int j) -> glm::vec3& { return tra[static_cast<size_t>(k) * nj + j]; };
+  if (len >= 4 && b < n && sk.has_locomotion_roles()) {
+    // 1. The stride's turn, taken back a little each frame about the foot that bears the weight
+    //    (the slower toe): a planted foot stays where it is while the body swings round it, and
+    //    the loop keeps one heading.
+    const TakeTrack tr = track_take(take, sk);
+    const float turn = tr.facing[b] - tr.facing[a];
+    std::vector<glm::mat4> model(sk.num_joints());
+    std::vector<glm::vec2> toe[2];
+    for (int k = 0; k <= len; ++k) {
+      LocalToModelJob{&sk, {&R(k, 0), static_cast<size_t>(nj)}, {&T(k, 0), static_cast<size_t>(nj)},
+                      glm::mat4(1.0f), model}
+          .run();
+      for (int s = 0; s < 2; ++s) {
+        const glm::vec3 p = translation_of(model[sk.toe(static_cast<Side>(s))]);
+        toe[s].emplace_back(p.x, p.z);
+      }
+    }
+    const float step = -turn / len;
+    float angle = 0.0f;  // frame k's map: x -> R(angle) x + shift
+    glm::vec2 shift(0.0f);
+    for (int k = 0; k <= len; ++k) {
+      const glm::quat q = glm::angleAxis(angle, glm::vec3(0, 1, 0));
+      const glm::vec3 rt = q * glm::vec3(T(k, 0).x, 0.0f, T(k, 0).z);
+      T(k, 0) = glm::vec3(rt.x + shift.x, T(k, 0).y, rt.z + shift.y);
+      R(k, 0) = glm::normalize(q * R(k, 0));
+      const int k1 = std::min(k + 1, len), k0 = std::max(k - 1, 0);
+      const int s = glm::length(toe[0][k1] - toe[0][k0]) <= glm::length(toe[1][k1] - toe[1][k0])
+                        ? 0
+                        : 1;
+      const glm::vec3 pm = q * glm::vec3(toe[s][k].x, 0.0f, toe[s][k].y);
+      const glm::vec2 pivot(pm.x + shift.x, pm.z + shift.y);
+      const glm::vec3 d = glm::angleAxis(step, glm::vec3(0, 1, 0)) *
+                          glm::vec3(shift.x - pivot.x, 0.0f, shift.y - pivot.y);
+      shift = glm::vec2(d.x + pivot.x, d.z + pivot.y);
+      angle += step;
+    }
+    // 2. Closing the loop: frame len must become frame 0 again. Each joint's mismatch is taken up
+    //    gradually: a leg's joints only while that foot swings (a planted foot never moves for
+    //    it), the rest of the body over the whole stride.
+    std::vector<int> leg(nj, -1);
+    for (int j = 0; j < nj; ++j) {
+      for (int s = 0; s < 2; ++s) {
+        for (int q = j; q >= 0; q = sk.parents[q]) {
+          if (q == sk.hip(static_cast<Side>(s))) leg[j] = s;
+        }
+      }
+    }
+    int swing_from[2] = {0, 0}, swing_to[2] = {len, len};
+    for (int s = 0; s < 2; ++s) {
+      std::vector<uint8_t> down(len + 1, 0);
+      for (const TimeInterval& iv : an.contacts[s]) {
+        const int f0 = static_cast<int>(std::lround(iv.start_s * fps)) - a;
+        const int f1 = static_cast<int>(std::lround(iv.end_s * fps)) - a;
+        for (int k = std::max(0, f0); k <= std::min(len, f1); ++k) down[k] = 1;
+      }
+      int best = 0;
+      for (int k = 0; k <= len;) {
+        if (down[k]) {
+          ++k;
+          continue;
+        }
+        int e = k;
+        while (e + 1 <= len && !down[e + 1]) ++e;
+        if (e - k + 1 > best) {
+          best = e - k + 1;
+          swing_from[s] = k;
+          swing_to[s] = e + 1;
+        }
+        k = e + 1;
+      }
+    }
+    auto smooth = [](float u) {
+      u = std::clamp(u, 0.0f, 1.0f);
+      return u * u * (3.0f - 2.0f * u);
+    };
+    for (int j = 0; j < nj; ++j) {
+      glm::quat diff = R(0, j) * glm::inverse(R(len, j));
+      if (diff.w < 0.0f) diff = -diff;
+      const glm::vec3 dt = T(0, j) - T(len, j);
+      for (int k = 1; k <= len; ++k) {
+        float w = static_cast<float>(k) / len;
+        if (leg[j] >= 0) {
+          const int s = leg[j];
+          w = smooth(static_cast<float>(k - swing_from[s]) /
+                     std::max(1, swing_to[s] - swing_from[s]));
+        }
+        R(k, j) = glm::normalize(glm::slerp(glm::quat(1, 0, 0, 0), diff, w) * R(k, j));
+        if (j == 0) {
+          T(k, j).y += w * dt.y;  // the root's travel stays its own; its height closes
+        } else {
+          T(k, j) += w * dt;
+        }
+      }
+    }
+    // 3. The root's travel: sampling carries a loop's root on by its last-minus-first step scaled
+    //    to a whole loop; a ramp (millimetres) makes that the stride's own displacement.
+    glm::vec3 want = T(len, 0) - T(0, 0);
+    want.y = 0.0f;
+    glm::vec3 have = (T(len - 1, 0) - T(0, 0)) * (static_cast<float>(len) / (len - 1));
+    have.y = 0.0f;
+    const glm::vec3 e = (want - have) * (static_cast<float>(len - 1) / len);
+    for (int k = 0; k < len; ++k) T(k, 0) += e * (static_cast<float>(k) / (len - 1));
+  }
+  c.rotations.assign(rot.begin(), rot.begin() + static_cast<size_t>(len) * nj);
+  c.translations.assign(tra.begin(), tra.begin() + static_cast<size_t>(len) * nj);
+  return c;
+}
+
+Clip extract_span(const Clip& take, TimeInterval span) {
+  const int n = take.num_frames, nj = take.num_joints;
+  const int a = frame_at(span.start_s, take.fps, n);
+  const int b = std::max(a, frame_at(span.end_s, take.fps, n));
+  Clip c;
+  c.name = take.name;
+  c.source = take.source;
+  c.fps = take.fps;
+  c.num_frames = b - a + 1;
+  c.num_joints = nj;
+  c.loops = false;
+  c.rotations.assign(take.frame_rotations(a), take.frame_rotations(b) + nj);
+  c.translations.assign(take.frame_translations(a), take.frame_translations(b) + nj);
+  return c;
+}
+
+}  // namespace gk
