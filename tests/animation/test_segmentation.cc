@@ -1,0 +1,233 @@
+// Long takes against what PROVENANCE.md of the subject-16 set states independently (speeds, the
+// start, the stop, the 90-degree turn), and the cut-out cycles against a stride period derived
+// here from the take's own toe heights (autocorrelation), not from contact analysis.
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "animation/analysis.h"
+#include "animation/clip_library.h"
+#include "animation/pose_jobs.h"
+#include "animation/segmentation.h"
+#include "tests/test_data.h"
+
+namespace gk {
+namespace {
+
+constexpr float kDeg = 180.0f / std::numbers::pi_v<float>;
+
+struct Take {
+  ClipSet set;
+  ClipAnalysis analysis;
+  TakeSegmentation seg;
+  const Clip& clip() const { return set.clips.at(0); }
+};
+
+Take load_take(const std::string& rel) {
+  Result<ClipSet> set = load_clip_file(test::data_path(rel));
+  EXPECT_TRUE(set.ok()) << set.message();
+  if (!set.ok()) return {};
+  Take t{std::move(*set), {}, {}};
+  t.analysis = analyze_clip(t.clip(), *t.set.skeleton);
+  t.seg = segment_take(t.clip(), *t.set.skeleton, t.analysis);
+  return t;
+}
+
+std::vector<glm::vec3> joint_track(const Clip& c, const Skeleton& sk, int joint) {
+  std::vector<glm::mat4> model(sk.num_joints());
+  std::vector<glm::vec3> out;
+  for (int f = 0; f < c.num_frames; ++f) {
+    LocalToModelJob{&sk,
+                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
+                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
+                    glm::mat4(1.0f),
+                    model}
+        .run();
+    out.push_back(translation_of(model[joint]));
+  }
+  return out;
+}
+
+// Stride period [s] of a take: the lag (0.5-2 s) at which the left toe's height best repeats
+// itself (normalised autocorrelation, first peak above 0.5 of the best).
+float toe_height_period(const Clip& c, const Skeleton& sk) {
+  const std::vector<glm::vec3> toe = joint_track(c, sk, sk.toe(Side::kLeft));
+  const int n = static_cast<int>(toe.size());
+  double mean = 0.0;
+  for (const glm::vec3& p : toe) mean += p.y;
+  mean /= n;
+  const int lo = static_cast<int>(0.5f * c.fps), hi = std::min(n - 4, static_cast<int>(2.0f * c.fps));
+  std::vector<double> r(hi + 2, 0.0);
+  for (int lag = lo; lag <= hi + 1 && lag < n; ++lag) {
+    double num = 0.0, d0 = 0.0, d1 = 0.0;
+    for (int f = 0; f + lag < n; ++f) {
+      const double x = toe[f].y - mean, y = toe[f + lag].y - mean;
+      num += x * y;
+      d0 += x * x;
+      d1 += y * y;
+    }
+    r[lag] = num / std::sqrt(std::max(d0 * d1, 1e-12));
+  }
+  const double best = *std::max_element(r.begin() + lo, r.begin() + hi + 1);
+  for (int lag = lo + 1; lag <= hi; ++lag) {
+    if (r[lag] >= 0.5 * best && r[lag] >= r[lag - 1] && r[lag] >= r[lag + 1]) return lag / c.fps;
+  }
+  return 0.0f;
+}
+
+const TakeSegment* first_of(const TakeSegmentation& s, SegmentKind kind) {
+  for (const TakeSegment& seg : s.segments) {
+    if (seg.kind == kind) return &seg;
+  }
+  return nullptr;
+}
+
+#define REQUIRE_TAKE(rel) GK_REQUIRE_DATA(rel)
+
+// Steady takes: one steady segment over (nearly) the whole take, at PROVENANCE.md's average root
+// speed within 5%, and a cycle one stride long.
+TEST(Segmentation, SteadyTakesAreOneSteadySegmentAtTheirSpeed) {
+  struct Case {
+    const char* file;
+    float speed_m_s;  // PROVENANCE.md "Average root speed"
+  };
+  for (const Case& c : {Case{"clips/bvh/more/cmu_16_11_walk_veer_left.bvh", 0.96f},
+                        Case{"clips/bvh/more/cmu_16_15_walk_mrl30.bvh", 1.17f},
+                        Case{"clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh", 1.73f},
+                        Case{"clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh", 2.86f}}) {
+    REQUIRE_TAKE(c.file);
+    const Take t = load_take(c.file);
+    ASSERT_FALSE(t.seg.segments.empty()) << c.file;
+    const TakeSegment* steady = first_of(t.seg, SegmentKind::kSteady);
+    ASSERT_NE(steady, nullptr) << c.file;
+    EXPECT_GT(steady->span.end_s - steady->span.start_s, 0.8f * t.analysis.duration_s) << c.file;
+    EXPECT_NEAR(steady->speed_m_s, c.speed_m_s, 0.05f * c.speed_m_s) << c.file;
+    EXPECT_TRUE(t.seg.problems.empty()) << c.file << ": " << t.seg.problems.front();
+    ASSERT_FALSE(t.seg.cycles.empty()) << c.file;
+  }
+}
+
+// Every cut-out cycle is one stride: as long as the period of the take's toe height, and with
+// exactly one contact of each foot when analysed as the loop the library plays.
+TEST(Segmentation, CyclesAreOneStrideLong) {
+  for (const char* file : {"clips/bvh/more/cmu_16_11_walk_veer_left.bvh",
+                           "clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh",
+                           "clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"}) {
+    REQUIRE_TAKE(file);
+    const Take t = load_take(file);
+    const Skeleton& sk = *t.set.skeleton;
+    const float period = toe_height_period(t.clip(), sk);
+    ASSERT_GT(period, 0.0f) << file;
+    ASSERT_FALSE(t.seg.cycles.empty()) << file;
+    for (const TakeSegment& seg : t.seg.segments) {
+      // A steady segment two periods long or more walks at the take's dominant stride.
+      if (seg.cycle < 0 || seg.span.end_s - seg.span.start_s < 2.0f * period) continue;
+      const Stride& st = t.seg.strides[seg.cycle];
+      EXPECT_NEAR(st.span.end_s - st.span.start_s, period, std::max(0.1f * period, 2.0f / t.clip().fps))
+          << file;
+    }
+    for (int ci : t.seg.cycles) {
+      const Clip loop = extract_cycle(t.clip(), sk, t.analysis, t.seg.strides[ci]);
+      EXPECT_TRUE(loop.loops);
+      EXPECT_NEAR(loop.duration_s(), t.seg.strides[ci].span.end_s - t.seg.strides[ci].span.start_s,
+                  1.0f / loop.fps) << file;
+      const ClipAnalysis la = analyze_clip(loop, sk);
+      EXPECT_EQ(la.contacts[0].size(), 1u) << file;
+      EXPECT_EQ(la.contacts[1].size(), 1u) << file;
+      // The loop travels the way the take's stride did, forward.
+      EXPECT_NEAR(la.native_speed_m_s, t.seg.strides[ci].speed_m_s,
+                  0.05f * t.seg.strides[ci].speed_m_s)
+          << file;
+      EXPECT_LT(std::abs(la.direction_rad) * kDeg, 10.0f) << file;
+    }
+  }
+}
+
+// The loop's seam adds no step the take did not have: for every joint, the change of its local
+// rotation from the loop's last frame to its first is at most the larger of the take's own step
+// there (the stride's last frame to the next) and the loop's largest step elsewhere, plus its share
+// of the closing.
+TEST(Segmentation, LoopSeamIsNoBiggerThanTheTakesSteps) {
+  for (const char* file : {"clips/bvh/more/cmu_16_11_walk_veer_left.bvh",
+                           "clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
+                           "clips/bvh/cmu_07_01_walk.bvh"}) {
+    REQUIRE_TAKE(file);
+    const Take t = load_take(file);
+    ASSERT_FALSE(t.seg.cycles.empty()) << file;
+    const Stride& st = t.seg.strides[t.seg.cycles[0]];
+    const Clip loop = extract_cycle(t.clip(), *t.set.skeleton, t.analysis, st);
+    const int a = static_cast<int>(std::lround(st.span.start_s * t.clip().fps));
+    const int n = loop.num_frames;
+    auto step = [](const Clip& c, int f0, int f1, int j) {
+      const float d = std::abs(glm::dot(c.frame_rotations(f0)[j], c.frame_rotations(f1)[j]));
+      return 2.0f * std::acos(std::min(1.0f, d));
+    };
+    for (int j = 1; j < loop.num_joints; ++j) {
+      float inside = 0.0f;
+      for (int f = 0; f + 1 < n; ++f) inside = std::max(inside, step(loop, f, f + 1, j));
+      const float take_step = step(t.clip(), a + n - 1, a + n, j);
+      // Closing the loop spreads the joint's mismatch between the stride's ends over its frames:
+      // each step may grow by at most that share (smoothstep-shaped for the legs: 1.5 times it).
+      const float share = 1.5f * step(t.clip(), a, a + n, j) / n;
+      EXPECT_LE(step(loop, n - 1, 0, j), std::max(inside, take_step) + share + 1e-4f)
+          << file << " joint " << t.set.skeleton->names[j];
+    }
+  }
+}
+
+// The start take (PROVENANCE.md: stands, then speeds up to a 1.3-1.4 m/s walk in about 1.5 s):
+// standing, then a start, then steady walking at the speed of its late windows (1.32, 1.41, 1.36,
+// 1.31 m/s).
+TEST(Segmentation, StartTakeStandsStartsThenWalks) {
+  const char* file = "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh";
+  REQUIRE_TAKE(file);
+  const Take t = load_take(file);
+  const TakeSegment* idle = first_of(t.seg, SegmentKind::kIdle);
+  const TakeSegment* start = first_of(t.seg, SegmentKind::kStart);
+  const TakeSegment* steady = first_of(t.seg, SegmentKind::kSteady);
+  ASSERT_NE(idle, nullptr);
+  ASSERT_NE(start, nullptr);
+  ASSERT_NE(steady, nullptr);
+  EXPECT_LT(idle->span.start_s, start->span.start_s);
+  EXPECT_LT(start->span.start_s, steady->span.start_s);
+  EXPECT_NEAR(start->span.end_s - idle->span.end_s, 1.5f, 0.5f);  // "in about 1.5 s"
+  const float late = (1.32f + 1.41f + 1.36f + 1.31f) / 4.0f;
+  EXPECT_NEAR(steady->speed_m_s, late, 0.05f * late);
+}
+
+// The stop takes end standing after a stop; the turn take turns left by about 90 degrees
+// (PROVENANCE.md: heading -3 -> +85 deg), most of it in its turn segment.
+TEST(Segmentation, StopsEndStandingAndTheTurnTurnsLeft) {
+  for (const char* file : {"clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh"}) {
+    REQUIRE_TAKE(file);
+    const Take t = load_take(file);
+    ASSERT_GE(t.seg.segments.size(), 2u) << file;
+    EXPECT_EQ(t.seg.segments.back().kind, SegmentKind::kIdle) << file;
+    EXPECT_EQ(t.seg.segments[t.seg.segments.size() - 2].kind, SegmentKind::kStop) << file;
+    const TakeSegment& stop = t.seg.segments[t.seg.segments.size() - 2];
+    EXPECT_GT(stop.speed_in_m_s, 3.0f * stop.speed_out_m_s) << file;
+  }
+  const char* file = "clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh";
+  REQUIRE_TAKE(file);
+  const Take t = load_take(file);
+  float total = 0.0f;
+  for (const TakeSegment& s : t.seg.segments) total += s.turn_rad;
+  EXPECT_NEAR(total * kDeg, 88.0f, 12.0f);
+  const TakeSegment* turn = first_of(t.seg, SegmentKind::kTurn);
+  ASSERT_NE(turn, nullptr);
+  EXPECT_GT(turn->turn_rad * kDeg, 45.0f);
+}
+
+}  // namespace
+}  // namespace gk
