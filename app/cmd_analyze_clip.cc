@@ -24,6 +24,7 @@ namespace {
 struct AnalyzeOptions {
   std::vector<std::string> files;
   float scale = 0.0f;
+  std::string roles;
   bool json = false;
 };
 
@@ -172,6 +173,7 @@ int run_analyze(const AnalyzeOptions& opt) {
   if (builtin) sets.push_back(make_builtin_clip_set());
   LoadOptions load;
   load.scale_m_per_unit = opt.scale;
+  load.role_manifest = opt.roles;
   int failures = 0;
   for (const std::string& f : files) {
     Result<ClipSet> set = load_clip_file(f, load);
@@ -187,7 +189,7 @@ int run_analyze(const AnalyzeOptions& opt) {
     if (!set.skeleton->has_locomotion_roles()) {
       std::fprintf(stderr,
                    "gaitkeeper analyze-clip: %s: skeleton lacks hips/leg joints the analysis needs "
-                   "(give a role manifest)\n",
+                   "(give a role manifest with --roles FILE.json)\n",
                    set.source.c_str());
       ++failures;
       continue;
@@ -232,6 +234,9 @@ void add_analyze_clip_command(CLI::App& app) {
   cmd->add_option("--scale", opt->scale,
                   "metres per file unit (default: detected from the leg length)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--roles", opt->roles,
+                  "JSON role manifest for the files' skeletons, e.g. {\"roles\": {\"left_knee\": "
+                  "\"Knee_L\", ...}} (default: roles detected from names and geometry)");
   cmd->add_flag("--json", opt->json, "print a JSON array instead of text");
   cmd->callback([opt] {
     const int code = run_analyze(*opt);

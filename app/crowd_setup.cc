@@ -109,6 +109,10 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
                   "apm (the whole mediator; default)");
   cmd->add_option("--clips", o->clips,
                   "BVH/glTF/GLB files or folders forming the clip library (default: built-in)");
+  cmd->add_option("--roles", o->roles,
+                  "JSON role manifest for the --clips files' skeletons, e.g. {\"roles\": "
+                  "{\"left_knee\": \"Knee_L\", ...}} (default: roles detected from names and "
+                  "geometry)");
   cmd->add_option("--set", o->sets,
                   "Mediator parameter, e.g. --set torsion_limit_deg=40 (repeatable)");
   cmd->add_option("--params", o->params_file, "JSON file of mediator parameters");
@@ -178,14 +182,19 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
 
 LocomotionLibrary load_library(const CrowdOptions& o) {
   std::vector<ClipSet> sets;
+  if (!o.roles.empty() && o.clips.empty()) {
+    fail(o.command, 2, "--roles " + o.roles + ": needs --clips (the built-in clips know their roles)");
+  }
   if (o.clips.empty()) {
     sets.push_back(make_builtin_clip_set());
   } else {
     auto files = expand_clip_paths(o.clips);
     if (!files.ok()) fail(o.command, 2, files.message());
     if (files->empty()) fail(o.command, 2, "--clips: no .bvh, .gltf or .glb file found");
+    LoadOptions load;
+    load.role_manifest = o.roles;
     for (const std::string& f : *files) {
-      auto set = load_clip_file(f);
+      auto set = load_clip_file(f, load);
       if (!set.ok()) fail(o.command, 2, set.message());
       sets.push_back(std::move(*set));
     }

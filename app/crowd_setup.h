@@ -33,6 +33,7 @@ struct CrowdOptions {
   std::string agents, seed = "1", threads = "1", trajectory_frame_time = "0.4";
   std::string mode = "apm";
   std::vector<std::string> clips;
+  std::string roles;  // JSON role manifest applied to every clip file (empty: roles detected)
   std::vector<std::string> sets;
   std::string params_file;
 };

@@ -471,7 +471,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     return Status::Error(
         sets[0].source +
         ": skeleton lacks the hips/leg joints the mediator needs (hips, hip, knee, "
-        "ankle and toe on both sides); give a role manifest");
+        "ankle and toe on both sides); give a role manifest with --roles FILE.json");
   }
   const std::vector<glm::mat4> rest = rest_model(sk);
   for (int s = 0; s < 2; ++s) lib.leg_length_m[s] = leg_length(sk, rest, static_cast<Side>(s));

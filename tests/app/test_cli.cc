@@ -334,5 +334,43 @@ TEST(CliBadInput, LongestRunStartsWithoutCrashing) {
       << over.out;
 }
 
+// --roles reaches the loader on every command that loads clips: a manifest that swaps the legs of
+// the subject-16 skeleton turns the analysed travel direction round (the hip line, and so the
+// facing, is reversed), and bench refuses a manifest naming a joint the skeleton lacks, naming the
+// manifest and the field.
+TEST(Cli, RolesManifestReachesAnalyzeClipAndBench) {
+  const char* clip = "clips/bvh/more/cmu_16_15_walk_mrl30.bvh";
+  GK_REQUIRE_DATA(clip);
+  const std::string dir = test::scratch_dir("cli_roles");
+  const std::string swapped = dir + "/swapped.json";
+  {
+    std::ofstream f(swapped);
+    f << R"({"roles": {"left_hip": "rfemur", "left_knee": "rtibia", "left_ankle": "rfoot",
+                       "left_toe": "rtoes", "right_hip": "lfemur", "right_knee": "ltibia",
+                       "right_ankle": "lfoot", "right_toe": "ltoes"}})";
+  }
+  const std::string out_plain = dir + "/plain.json", out_swapped = dir + "/swapped_out.json";
+  ASSERT_EQ(run("analyze-clip --json " + test::data_path(clip) + " > " + out_plain).code, 0);
+  const CommandResult r = run("analyze-clip --json --roles " + swapped + " " +
+                              test::data_path(clip) + " > " + out_swapped);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const double plain = read_json(out_plain)[0]["direction_deg"].get<double>();
+  const double turned = read_json(out_swapped)[0]["direction_deg"].get<double>();
+  EXPECT_LT(std::abs(plain), 10.0);
+  EXPECT_GT(std::abs(turned), 170.0);
+
+  const std::string wrong = dir + "/wrong.json";
+  {
+    std::ofstream f(wrong);
+    f << R"({"roles": {"left_knee": "Knee_L"}})";
+  }
+  const CommandResult b = run("bench --scenario corridor --agents 4 --frames 10 --clips " +
+                              test::data_path(clip) + " --roles " + wrong);
+  EXPECT_EQ(b.code, 2) << b.out;
+  EXPECT_NE(b.out.find("wrong.json"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("roles.left_knee"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("Knee_L"), std::string::npos) << b.out;
+}
+
 }  // namespace
 }  // namespace gk
