@@ -16,7 +16,9 @@
 #include "animation/clip_library.h"
 #include "animation/procedural.h"
 #include "animation/segmentation.h"
+#include "app/clip_plot.h"
 #include "app/commands.h"
+#include "app/crowd_setup.h"
 
 namespace gk::app {
 namespace {
@@ -25,6 +27,7 @@ struct AnalyzeOptions {
   std::vector<std::string> files;
   float scale = 0.0f;
   std::string roles;
+  std::string plot;
   bool json = false;
 };
 
@@ -169,6 +172,7 @@ int run_analyze(const AnalyzeOptions& opt) {
     }
     files = *expanded;
   }
+  check_output_file_option("analyze-clip", opt.plot, "--plot");
   std::vector<ClipSet> sets;
   if (builtin) sets.push_back(make_builtin_clip_set());
   LoadOptions load;
@@ -185,6 +189,13 @@ int run_analyze(const AnalyzeOptions& opt) {
     sets.push_back(std::move(*set));
   }
   nlohmann::json all = nlohmann::json::array();
+  struct Plotted {
+    const Clip* clip;
+    const Skeleton* skeleton;
+    ClipAnalysis analysis;
+    TakeSegmentation segmentation;
+  };
+  std::vector<Plotted> plotted;
   for (const ClipSet& set : sets) {
     if (!set.skeleton->has_locomotion_roles()) {
       std::fprintf(stderr,
@@ -213,11 +224,21 @@ int run_analyze(const AnalyzeOptions& opt) {
                          {"foot_slide_floor_cm_s", la.floor.mean_cm_s}});
       }
       j["take"]["loops"] = std::move(loops);
+      if (!opt.plot.empty()) plotted.push_back({&clip, set.skeleton.get(), a, seg});
       if (!opt.json) print_text(j);
       all.push_back(std::move(j));
     }
   }
   if (opt.json) std::cout << all.dump(2) << "\n";
+  if (!plotted.empty()) {
+    std::vector<ClipPlotInput> in;
+    for (const Plotted& p : plotted) in.push_back({p.clip, p.skeleton, &p.analysis, &p.segmentation});
+    if (Status s = write_clip_plot(opt.plot, in); !s.ok()) {
+      std::fprintf(stderr, "gaitkeeper analyze-clip: --plot %s\n", s.message().c_str());
+      return 1;
+    }
+    if (!opt.json) std::printf("wrote %s (%zu clips)\n", opt.plot.c_str(), in.size());
+  }
   return failures > 0 ? 1 : 0;
 }
 
@@ -237,6 +258,10 @@ void add_analyze_clip_command(CLI::App& app) {
   cmd->add_option("--roles", opt->roles,
                   "JSON role manifest for the files' skeletons, e.g. {\"roles\": {\"left_knee\": "
                   "\"Knee_L\", ...}} (default: roles detected from names and geometry)");
+  cmd->add_option("--plot", opt->plot,
+                  "write a PNG: per clip, each toe's height and speed over time with the contacts "
+                  "shaded, and the take's segments (idle, start, steady, turn, stop) with the "
+                  "loops cut out of it");
   cmd->add_flag("--json", opt->json, "print a JSON array instead of text");
   cmd->callback([opt] {
     const int code = run_analyze(*opt);

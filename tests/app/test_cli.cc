@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/app/cli_support.h"
+#include "app/clip_plot.h"
 #include "tests/test_data.h"
 
 namespace gk {
@@ -370,6 +371,48 @@ TEST(Cli, RolesManifestReachesAnalyzeClipAndBench) {
   EXPECT_NE(b.out.find("wrong.json"), std::string::npos) << b.out;
   EXPECT_NE(b.out.find("roles.left_knee"), std::string::npos) << b.out;
   EXPECT_NE(b.out.find("Knee_L"), std::string::npos) << b.out;
+}
+
+// analyze-clip --plot draws what the analysis found: one block of panels per clip, and in the left
+// toe's height panel the pixels under the middle of each left contact are shaded (green), those in
+// the middle of each gap between left contacts are not. An unwritable --plot path fails before the
+// work.
+TEST(Cli, AnalyzeClipPlotShadesTheContactsItReports) {
+  const char* clip = "clips/bvh/more/cmu_16_15_walk_mrl30.bvh";
+  GK_REQUIRE_DATA(clip);
+  const std::string dir = test::scratch_dir("cli_plot");
+  const std::string png = dir + "/plot.png", json = dir + "/analysis.json";
+  const CommandResult r =
+      run("analyze-clip --json --plot " + png + " " + test::data_path(clip) + " > " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const test::Image img = test::read_png(png);
+  ASSERT_EQ(img.width, app::kClipPlotWidth);
+  ASSERT_EQ(img.height, app::kClipPlotHeight);
+  const nlohmann::json a = read_json(json)[0];
+  const double dur = a["duration_s"].get<double>();
+  auto pixel_x = [&](double t) {
+    return static_cast<int>(app::kClipPlotLeft + (app::kClipPlotRight - app::kClipPlotLeft) * t / dur);
+  };
+  // A pixel near the top of the left-height panel (above the curve).
+  const int y = app::kClipPlotPanelTop + 4;
+  auto greenish = [&](int x) {
+    const uint8_t* p = &img.rgba[(static_cast<size_t>(y) * img.width + x) * 4];
+    return p[1] > p[0] + 30 && p[1] > p[2] + 30;
+  };
+  const auto& left = a["contacts"]["left"];
+  ASSERT_GE(left.size(), 2u);
+  for (size_t i = 0; i < left.size(); ++i) {
+    const double t0 = left[i][0].get<double>(), t1 = left[i][1].get<double>();
+    EXPECT_TRUE(greenish(pixel_x(0.5 * (t0 + t1)))) << "contact " << i;
+    if (i + 1 < left.size()) {
+      const double gap = 0.5 * (t1 + left[i + 1][0].get<double>());
+      EXPECT_FALSE(greenish(pixel_x(gap))) << "gap after contact " << i;
+    }
+  }
+  const CommandResult bad =
+      run("analyze-clip --plot /nonexistent_dir/x.png " + test::data_path(clip));
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("--plot"), std::string::npos) << bad.out;
 }
 
 }  // namespace
