@@ -23,12 +23,32 @@ float wrap_angle(float a) {
 // World positions of the joints analysis needs, one row per frame.
 struct Tracks {
   std::vector<glm::vec3> root, toe[2], ankle[2], hip[2];
+  // Two points no rig has a joint for. The toe tip: the toe joint's bone tip (its End Site, else
+  // its first child), the last point to leave the ground as the foot rolls off. The heel: a point
+  // fixed to the ankle where the floor was under it when the foot stood flat (the take's frame
+  // with the ball lowest), the first to touch at a heel strike while the ankle still rolls
+  // forward. Without a tip, the ball stands in for it.
+  std::vector<glm::vec3> tip[2], heel[2];
 };
 
 Tracks track_clip_frames(const Clip& clip, const Skeleton& sk) {
   Tracks t;
   std::vector<glm::mat4> model(sk.num_joints());
   const int hips = std::max(sk.role(JointRole::kHips), 0);
+  std::vector<glm::mat4> ankle_m[2];
+  glm::vec3 tip_local[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
+  for (int s = 0; s < 2; ++s) {
+    const int toe = sk.toe(static_cast<Side>(s));
+    if (toe >= 0 && static_cast<size_t>(toe) < sk.end_sites.size()) tip_local[s] = sk.end_sites[toe];
+    if (glm::length(tip_local[s]) < 1e-6f) {
+      for (int j = toe + 1; j < sk.num_joints(); ++j) {
+        if (sk.parents[j] == toe) {
+          tip_local[s] = sk.rest_translations[j];
+          break;
+        }
+      }
+    }
+  }
   for (int f = 0; f < clip.num_frames; ++f) {
     LocalToModelJob fk{&sk,
                        {clip.frame_rotations(f), static_cast<size_t>(clip.num_joints)},
@@ -42,7 +62,21 @@ Tracks track_clip_frames(const Clip& clip, const Skeleton& sk) {
       t.toe[s].push_back(translation_of(model[sk.toe(side)]));
       t.ankle[s].push_back(translation_of(model[sk.ankle(side)]));
       t.hip[s].push_back(translation_of(model[sk.hip(side)]));
+      t.tip[s].push_back(glm::vec3(model[sk.toe(side)] * glm::vec4(tip_local[s], 1.0f)));
+      ankle_m[s].push_back(model[sk.ankle(side)]);
     }
+  }
+  for (int s = 0; s < 2; ++s) {
+    const int n = clip.num_frames;
+    int flat = 0;
+    for (int f = 1; f < n; ++f) {
+      if (t.toe[s][f].y < t.toe[s][flat].y) flat = f;
+    }
+    const glm::vec3 a = t.ankle[s][flat];
+    const float floor_y = std::min(t.toe[s][flat].y, t.tip[s][flat].y);
+    const glm::vec3 heel_local =
+        glm::vec3(glm::inverse(ankle_m[s][flat]) * glm::vec4(a.x, std::min(floor_y, a.y), a.z, 1.0f));
+    for (int f = 0; f < n; ++f) t.heel[s].push_back(glm::vec3(ankle_m[s][f] * glm::vec4(heel_local, 1.0f)));
   }
   return t;
 }
@@ -101,8 +135,11 @@ void filter_runs(std::vector<uint8_t>& c, int min_frames, bool loops) {
       }
       size_t j = i;
       while (j < n && c[j] == value) ++j;
+      // A run cut by a take's first or last frame may be the end of a longer one: kept when it
+      // lasts two frames (one frame there is a foot passing low, or arriving as the take ends).
       const bool touches_edge = !loops && (i == 0 || j == n);
-      if (static_cast<int>(j - i) < min_frames && !touches_edge) {
+      const int need = touches_edge ? std::min(2, min_frames) : min_frames;
+      if (static_cast<int>(j - i) < need) {
         std::fill(c.begin() + i, c.begin() + j, static_cast<uint8_t>(1 - value));
       }
       i = j;
@@ -185,7 +222,9 @@ int velocity_half_window(float fps) {
 // Horizontal velocity of track p at frame f relative to the clip's hips (in_place) or the world,
 // by a central difference over +-k frames (wrapping a loop, whose root jumps back by per_loop).
 glm::vec3 track_velocity(const std::vector<glm::vec3>& p, const Tracks& tr, int f, int k,
-                         const Clip& clip, bool relative_to_root) {
+                         const Clip& clip, bool relative_to_root, int back = -1, int fwd = -1) {
+  if (back < 0) back = k;
+  if (fwd < 0) fwd = k;
   const int n = static_cast<int>(p.size());
   const glm::vec3 per_loop = (tr.root[n - 1] - tr.root[0]) * (static_cast<float>(n) / (n - 1));
   auto at = [&](int i) {
@@ -201,8 +240,8 @@ glm::vec3 track_velocity(const std::vector<glm::vec3>& p, const Tracks& tr, int 
     if (relative_to_root) q -= tr.root[i] + shift;
     return q;
   };
-  const int lo = clip.loops ? f - k : std::max(0, f - k);
-  const int hi = clip.loops ? f + k : std::min(n - 1, f + k);
+  const int lo = clip.loops ? f - back : std::max(0, f - back);
+  const int hi = clip.loops ? f + fwd : std::min(n - 1, f + fwd);
   if (hi == lo) return glm::vec3(0.0f);
   glm::vec3 v = (at(hi) - at(lo)) * (clip.fps / static_cast<float>(hi - lo));
   v.y = 0.0f;
@@ -234,10 +273,10 @@ glm::vec3 in_place_travel(const Tracks& tr, const Clip& clip) {
   return travel;
 }
 
-// One foot's contact frames: its ball or its heel (ankle) nearly still over the ground and low.
-// "Still" is relative to the clip's own travel speed (a stance foot moves a small fraction of it;
-// a swing foot about twice it); "low" is relative to the joint's own lowest heights over the fitted
-// ground (a gate well below the swing's height, never the judge alone).
+// One foot's contact frames: its heel, ankle, ball or toe tip nearly still over the ground and low.
+// "Still" is relative to the clip's own travel speed (a planted point moves slower than half the
+// body's speed; a swing foot moves about twice it); "low" is relative to the point's own lowest
+// heights over the fitted ground (a gate well below the swing's height, never the judge alone).
 void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalysis& a,
                      const glm::vec3& travel_vel, const ContactThresholds& th,
                      std::vector<uint8_t>* out) {
@@ -246,9 +285,9 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
   const float still =
       std::max(th.min_still_speed_m_s, th.still_fraction_of_travel * glm::length(travel_vel));
   out->assign(n, 0);
-  const std::vector<glm::vec3>* joints[2] = {&tr.toe[s], &tr.ankle[s]};
-  std::vector<uint8_t> down[2];
-  for (int j = 0; j < 2; ++j) {
+  const std::vector<glm::vec3>* joints[4] = {&tr.toe[s], &tr.ankle[s], &tr.heel[s], &tr.tip[s]};
+  std::vector<uint8_t> down[4];
+  for (int j = 0; j < 4; ++j) {
     const std::vector<glm::vec3>& p = *joints[j];
     std::vector<float> h(n), speed(n);
     std::vector<uint8_t> backward(n, 0);
@@ -259,15 +298,23 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
       // In place, a stance foot is carried backward under the hips and a swing foot forward: the
       // sign holds even for keyframed clips whose stance foot is not ground-consistent.
       if (a.in_place && travel > 0.0f) backward[f] = glm::dot(v, travel_vel) < 0.0f;
-      if (a.in_place) v += travel_vel;
-      speed[f] = glm::length(v);
+      // Still on either side: a foot that has just arrived stays from this frame on (its step in
+      // was still fast), a foot about to leave came to this frame slowly; a centred difference
+      // would blur a frame off each end of every contact.
+      glm::vec3 vb = track_velocity(p, tr, f, k, clip, a.in_place, k, 0);
+      glm::vec3 vf = track_velocity(p, tr, f, k, clip, a.in_place, 0, k);
+      if (a.in_place) {
+        vb += travel_vel;
+        vf += travel_vel;
+      }
+      speed[f] = std::min(glm::length(vb), glm::length(vf));
     }
     const float low = percentile(h, 0.05f), high = percentile(h, 0.95f);
     const float gate = low + std::max(th.min_height_gate_m, th.height_gate_fraction * (high - low));
     down[j].assign(n, 0);
     for (int f = 0; f < n; ++f) down[j][f] = (speed[f] < still || backward[f]) && h[f] <= gate;
   }
-  for (int f = 0; f < n; ++f) (*out)[f] = down[0][f] || down[1][f];
+  for (int f = 0; f < n; ++f) (*out)[f] = down[0][f] || down[1][f] || down[2][f] || down[3][f];
 }
 
 // In a walk or a run the feet take turns: between two contacts of one foot the other foot lands.

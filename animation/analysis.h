@@ -19,7 +19,7 @@ struct TimeInterval {
 // ground and low. Speeds are relative to the clip's own travel speed so that a walk and a sprint
 // are judged alike; heights relative to the joint's own range over the fitted ground.
 struct ContactThresholds {
-  float still_fraction_of_travel = 0.3f;  // [ratio] "still": slower than this share of travel
+  float still_fraction_of_travel = 0.5f;  // [ratio] "still": slower than half the travel speed
   float min_still_speed_m_s = 0.2f;       // [m/s] and never a stricter limit than this (capture
                                           // jitter; standing clips)
   float height_gate_fraction = 0.3f;      // [ratio] low: within this share of the joint's range

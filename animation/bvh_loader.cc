@@ -21,6 +21,7 @@ struct BvhJoint {
   std::string name;
   int parent = -1;
   glm::vec3 offset{0.0f};
+  glm::vec3 end_site{0.0f};  // the End Site's OFFSET, when the joint ends a chain
   std::vector<Channel> channels;
 };
 
@@ -77,7 +78,7 @@ class BvhParser {
   }
   Status read_vec3(glm::vec3* out);
   Status parse_joint(int parent, int depth);
-  Status parse_end_site();
+  Status parse_end_site(int joint);
 
   internal::TextScanner scan_;
   std::string source_;
@@ -103,8 +104,9 @@ Status BvhParser::read_vec3(glm::vec3* out) {
   return Status::Ok();
 }
 
-Status BvhParser::parse_end_site() {
-  // "End Site" ends a chain: its offset only gives the bone tip, it is not a joint.
+Status BvhParser::parse_end_site(int joint) {
+  // "End Site" ends a chain: its offset only gives the bone tip (kept: a toe's tip is where a
+  // foot rolling off the ground touches it last), it is not a joint.
   scan_.rest_of_line();
   GK_RETURN_IF_ERROR(expect("{"));
   for (;;) {
@@ -116,8 +118,7 @@ Status BvhParser::parse_end_site() {
       return error(scan_.line(),
                    "unknown keyword " + quoted(tok) + " in End Site (expected OFFSET or '}')");
     }
-    glm::vec3 ignored;
-    GK_RETURN_IF_ERROR(read_vec3(&ignored));
+    GK_RETURN_IF_ERROR(read_vec3(&joints_[joint].end_site));
   }
 }
 
@@ -132,7 +133,7 @@ Status BvhParser::parse_joint(int parent, int depth) {
     return error(line, "more than " + std::to_string(options_.max_joints) + " joints");
   }
   const int self = static_cast<int>(joints_.size());
-  joints_.push_back({std::string(name), parent, glm::vec3(0.0f), {}});
+  joints_.push_back({std::string(name), parent, glm::vec3(0.0f), glm::vec3(0.0f), {}});
   GK_RETURN_IF_ERROR(expect("{"));
   for (;;) {
     const std::string_view tok = scan_.next();
@@ -165,7 +166,7 @@ Status BvhParser::parse_joint(int parent, int depth) {
     } else if (tok == "JOINT") {
       GK_RETURN_IF_ERROR(parse_joint(self, depth + 1));
     } else if (tok == "End") {
-      GK_RETURN_IF_ERROR(parse_end_site());
+      GK_RETURN_IF_ERROR(parse_end_site(self));
     } else {
       return error(tok_line, "unknown keyword " + quoted(tok) +
                                  " (expected OFFSET, CHANNELS, JOINT, End Site or '}')");
@@ -387,6 +388,7 @@ Result<ClipSet> parse_bvh(std::string_view text, const std::string& source_name,
     skeleton->parents.push_back(static_cast<int16_t>(j.parent));
     skeleton->rest_translations.push_back(j.offset);
     skeleton->rest_rotations.push_back(glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+    skeleton->end_sites.push_back(j.end_site);
   }
   GK_RETURN_IF_ERROR(validate_skeleton(*skeleton, source_name));
   detect_joint_roles(skeleton.get());
@@ -403,6 +405,7 @@ Result<ClipSet> parse_bvh(std::string_view text, const std::string& source_name,
     set.scale_m_per_unit = detect_unit_scale(*skeleton, &set.scale_reason);
   }
   for (glm::vec3& t : skeleton->rest_translations) t *= set.scale_m_per_unit;
+  for (glm::vec3& t : skeleton->end_sites) t *= set.scale_m_per_unit;
 
   Result<Clip> clip = parser.parse_motion(set.scale_m_per_unit);
   GK_RETURN_IF_ERROR(clip);

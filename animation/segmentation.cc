@@ -268,10 +268,11 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
       }
     }
     out.cycles.push_back(least);
+    out.fallback_cycle = true;
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   "no steady stride (the body speeds up, slows down or turns in every one): the "
-                  "least unsteady stride, %.2f-%.2f s (speed change %.0f%%), is used as the cycle",
+                  "least unsteady stride, %.2f-%.2f s (speed change %.0f%%), is the cycle if the library has no steady one",
                   out.strides[least].span.start_s, out.strides[least].span.end_s,
                   100.0f * out.strides[least].speed_change);
     out.problems.push_back(buf);

@@ -57,6 +57,7 @@ struct TakeSegmentation {
   // Strides cut out as loops: one per steady segment; when no stride is steady, the least
   // unsteady one (and `problems` says so).
   std::vector<int> cycles;
+  bool fallback_cycle = false;  // `cycles` holds the least unsteady stride, not a steady one
   // What is doubtful or unusable, and why (plain sentences for analyze-clip and the library).
   std::vector<std::string> problems;
 };

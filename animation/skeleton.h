@@ -53,6 +53,9 @@ struct Skeleton {
   // Rest pose, local to the parent [m].
   std::vector<glm::vec3> rest_translations;
   std::vector<glm::quat> rest_rotations;
+  // Per joint, the tip of its bone where the file gives one (BVH End Site), local to the joint
+  // [m]; empty, or zero for a joint without one.
+  std::vector<glm::vec3> end_sites;
   // Joint index per role, -1 if absent.
   std::array<int16_t, kNumJointRoles> roles;
   // Joints from the first spine joint above the hips up to and including the chest, bottom first:

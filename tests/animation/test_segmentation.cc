@@ -3,12 +3,15 @@
 // here from the take's own toe heights (autocorrelation), not from contact analysis.
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <cmath>
 #include <numbers>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "animation/analysis.h"
 #include "animation/clip_library.h"
@@ -227,6 +230,41 @@ TEST(Segmentation, StopsEndStandingAndTheTurnTurnsLeft) {
   const TakeSegment* turn = first_of(t.seg, SegmentKind::kTurn);
   ASSERT_NE(turn, nullptr);
   EXPECT_GT(turn->turn_rad * kDeg, 45.0f);
+}
+
+// Contacts against hand labels (tests/data/contact_labels: touchdown and lift-off frames judged
+// frame by frame from heel and toe height and speed traces, by someone who had not seen this
+// program's output): the same contacts, each touchdown and lift-off within 2 frames (a contact
+// cut by the take's first or last frame is checked at its other end only).
+TEST(Segmentation, ContactsMatchHandLabelsWithinTwoFrames) {
+  const std::string dir = test::source_path("tests/data/contact_labels");
+  int checked = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    std::ifstream in(entry.path());
+    const nlohmann::json labels = nlohmann::json::parse(in);
+    const std::string rel = "clips/bvh/more/" + labels["clip"].get<std::string>();
+    REQUIRE_TAKE(rel);
+    const Take t = load_take(rel);
+    const int last = t.clip().num_frames - 1;
+    for (int s = 0; s < 2; ++s) {
+      const nlohmann::json& want = labels[s == 0 ? "left" : "right"];
+      const std::vector<TimeInterval>& got = t.analysis.contacts[s];
+      ASSERT_EQ(got.size(), want.size()) << rel << (s == 0 ? " left" : " right");
+      for (size_t i = 0; i < got.size(); ++i) {
+        const int g0 = static_cast<int>(std::lround(got[i].start_s * t.clip().fps));
+        const int g1 = static_cast<int>(std::lround(got[i].end_s * t.clip().fps));
+        const int w0 = want[i][0].get<int>(), w1 = want[i][1].get<int>();
+        if (w0 > 0) {
+          EXPECT_NEAR(g0, w0, 2) << rel << " side " << s << " contact " << i << " touchdown";
+        }
+        if (w1 < last) {
+          EXPECT_NEAR(g1, w1, 2) << rel << " side " << s << " contact " << i << " lift-off";
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 30);
 }
 
 }  // namespace
