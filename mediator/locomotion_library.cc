@@ -91,47 +91,6 @@ Clip make_in_place(const Clip& src, const Skeleton& sk, const ClipAnalysis& a, f
   return c;
 }
 
-// A start or stop made in place: the root's own smoothed path over the ground (hips averaged
-// over +-0.25 s) is taken out, so what stays is the pelvis's sway and bob; facing turned to +z.
-// Returns the per-frame velocity taken out (in the turned frame) and its ground speed.
-Clip make_transition_in_place(const Clip& src, const Skeleton& sk, float facing_rad,
-                              std::vector<glm::vec3>* removed, std::vector<float>* speed) {
-  Clip c = src;
-  const int n = c.num_frames, nj = c.num_joints;
-  const int hips = sk.role(JointRole::kHips);
-  std::vector<glm::mat4> model(nj);
-  std::vector<glm::vec3> h(n);
-  for (int f = 0; f < n; ++f) {
-    frame_model(c, sk, f, model);
-    h[f] = translation_of(model[hips]);
-    h[f].y = 0.0f;
-  }
-  const int k = std::max(1, static_cast<int>(std::lround(0.25f * c.fps)));
-  std::vector<glm::vec3> path(n);
-  for (int f = 0; f < n; ++f) {
-    glm::vec3 sum(0.0f);
-    int cnt = 0;
-    for (int g = std::max(0, f - k); g <= std::min(n - 1, f + k); ++g, ++cnt) sum += h[g];
-    path[f] = sum / static_cast<float>(cnt);
-  }
-  const glm::quat yaw = glm::angleAxis(-facing_rad, glm::vec3(0, 1, 0));
-  removed->assign(n, glm::vec3(0.0f));
-  speed->assign(n, 0.0f);
-  for (int f = 0; f < n; ++f) {
-    const int lo = std::max(0, f - 1), hi = std::min(n - 1, f + 1);
-    const glm::vec3 v = hi > lo ? (path[hi] - path[lo]) * (c.fps / (hi - lo)) : glm::vec3(0.0f);
-    (*removed)[f] = yaw * v;
-    (*speed)[f] = glm::length(v);
-  }
-  for (int f = 0; f < n; ++f) {
-    glm::quat& r = c.rotations[static_cast<size_t>(f) * nj];
-    glm::vec3& t = c.translations[static_cast<size_t>(f) * nj];
-    r = yaw * r;
-    t = yaw * (t - path[f]);
-  }
-  return c;
-}
-
 // Facing of the character in a clip: perpendicular to the right->left hip vector, averaged.
 float clip_facing(const Clip& c, const Skeleton& sk) {
   std::vector<glm::mat4> model(sk.num_joints());
@@ -258,10 +217,8 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     std::vector<float> speed(n);
     for (int f = 0; f < n; ++f) {
       const int g = f + 1 < n ? f + 1 : (c.loops ? 0 : f - 1);
-      const glm::vec3 removed =
-          lc->removed_velocity.empty() ? travel : lc->removed_velocity[static_cast<size_t>(f)];
-      glm::vec3 vel = (toe[s][g] - toe[s][f]) * (g > f ? c.fps : -c.fps) + removed;
-      if (g == 0) vel = removed;  // across a loop's wrap: no reliable difference
+      glm::vec3 vel = (toe[s][g] - toe[s][f]) * (g > f ? c.fps : -c.fps) + travel;
+      if (g == 0) vel = travel;  // across a loop's wrap: no reliable difference
       speed[f] = std::hypot(vel.x, vel.z);
       lc->toe_height_m[s][f] = toe[s][f].y - min_t;
     }
@@ -521,7 +478,6 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   const float dst_leg = 0.5f * (lib.leg_length_m[0] + lib.leg_length_m[1]);
 
   std::vector<LocomotionClip> idles;
-  std::vector<LocomotionClip> transitions;
   struct Fallback {
     Clip loop, take;
   };
@@ -592,32 +548,6 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         }
         report.clips.push_back(loop.name);
         add(std::move(loop), k == 0 ? &clip : nullptr);
-      }
-      // Starts and stops: from a little standing before (a start) or walking before (a stop) to
-      // a little walking (a start) or standing (a stop) after, as the take has them.
-      for (const TakeSegment& s : seg.segments) {
-        if (s.kind != SegmentKind::kStart && s.kind != SegmentKind::kStop) continue;
-        const float lead = 0.25f, tail = 0.4f;
-        const TimeInterval span{std::max(0.0f, s.span.start_s - lead),
-                                std::min(levelled.duration_s, s.span.end_s + tail)};
-        Clip part = extract_span(clip, span);
-        part.name += s.kind == SegmentKind::kStart ? " (start)" : " (stop)";
-        LocomotionClip lc;
-        lc.start = s.kind == SegmentKind::kStart;
-        lc.stop = !lc.start;
-        lc.analysis = analyze_clip(part, sk);
-        lc.clip = make_transition_in_place(part, sk, clip_facing(part, sk), &lc.removed_velocity,
-                                           &lc.transition_speed_m_s);
-        const int f0 = static_cast<int>(std::lround(span.start_s * clip.fps));
-        for (int f = 0; f < part.num_frames; ++f) {
-          lc.transition_phase.push_back(
-              levelled.phase[static_cast<size_t>(std::min(f0 + f, clip.num_frames - 1))]);
-        }
-        fill_contacts_and_heights(&lc, sk);
-        lc.cycle_s = lc.clip.duration_s();
-        if (lc.analysis.contacts[0].empty() || lc.analysis.contacts[1].empty()) continue;
-        report.clips.push_back(lc.clip.name);
-        transitions.push_back(std::move(lc));
       }
       for (const TakeSegment& s : seg.segments) {
         if (s.kind != SegmentKind::kIdle || s.span.end_s - s.span.start_s < 0.2f) continue;
@@ -693,10 +623,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         synthesise_idle(lib.clips[lib.groups[lib.forward_group].clips.front()], sk));
   }
   lib.idle = static_cast<int>(lib.clips.size()) - 1;
-  for (LocomotionClip& t : transitions) {
-    (t.start ? lib.starts : lib.stops).push_back(static_cast<int>(lib.clips.size()));
-    lib.clips.push_back(std::move(t));
-  }
+
   // One floor for every clip: captures (and actors) stand at different heights, so each clip is
   // raised or lowered until its flat feet stand where the clips' flat feet stand on the median.
   {

@@ -41,14 +41,6 @@ struct LocomotionClip {
   // How far through its swing each foot is, 0 where it leaves the ground to 1 where it lands
   // (0 while planted).
   std::vector<float> swing_progress[2];
-  // A start or a stop cut from a take: played once, first frame to last, not blended by speed.
-  // Per frame: the root's smoothed ground speed there [m/s], the take's gait phase (to hand over
-  // to the cycles in step), and the travel velocity taken out of the root (in place, facing +z).
-  bool start = false;
-  bool stop = false;
-  std::vector<float> transition_speed_m_s;
-  std::vector<float> transition_phase;
-  std::vector<glm::vec3> removed_velocity;
   float toe_floor_m[2] = {0.0f, 0.0f};     // lowest toe height in the clip
   float ankle_floor_m[2] = {0.0f, 0.0f};   // lowest ankle height in the clip
   float time_at_phase(float phase) const;  // phase in [0, 1)
@@ -96,7 +88,6 @@ struct LocomotionLibrary {
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;
   std::vector<TakeReport> takes;  // takes with root motion, as segmented
-  std::vector<int> starts, stops;  // transition clips (indices into clips)
   std::vector<std::string> clip_names() const;
   bool has_direction_clips() const { return groups.size() > 1; }
 };
