@@ -188,7 +188,13 @@ void run_render(RenderOptions& o) {
     OrbitCamera& c = scene.view->camera();
     c.pitch_rad = kFollowPitch_rad;
     c.distance_m = kFollowDistance_m;
-    if (!o.camera.empty()) apply_camera(o.camera, &c);
+    if (!o.camera.empty()) {
+      apply_camera(o.camera, &c);
+      // The pull-out ends on the whole scene seen from the same side.
+      OrbitCamera overview = director.overview();
+      overview.yaw_rad = c.yaw_rad;
+      director.set_overview(overview);
+    }
     director.follow(follow, c.distance_m, c.pitch_rad);
     director.snap();
     if (pull_out_s >= 0.0) director.pull_out_at(pull_out_s);

@@ -119,6 +119,7 @@ class DemoApp {
   bool paused_ = false;
   bool step_requested_ = false;
   bool help_ = false;
+  bool help_focused_ = false;  // the help window was brought to the front since it opened
   bool quit_ = false;
   bool restart_requested_ = false;
   float time_scale_ = 1.0f;

@@ -217,7 +217,11 @@ void DemoApp::panel_view() {
 
 void DemoApp::panel_metrics() {
   const bool behind = clock_.behind() && !paused_;
-  ImGui::Text("%.0f FPS", fps_);
+  if (fps_ > 0.0f) {
+    ImGui::Text("%.0f FPS", fps_);
+  } else {
+    ImGui::TextDisabled("FPS after 0.5 s");
+  }
   ImGui::SameLine();
   if (behind) {
     ImGui::TextColored(ImVec4(1.0f, 0.65f, 0.25f, 1.0f), "simulation at %.2fx real time",
