@@ -6,6 +6,13 @@
 #include "app/crowd_setup.h"
 
 namespace gk::app {
+namespace {
+
+// A frame a little short of a whole step still runs it (and owes the difference): a 60 Hz
+// display's frame times jitter around one step, which would otherwise run 0, 2, 1, ... steps.
+constexpr double kJitter = 0.1;
+
+}  // namespace
 
 double SimClock::step_s(double time_scale) { return kFrameTime_s * std::min(time_scale, 1.0); }
 
@@ -19,9 +26,6 @@ int SimClock::begin_frame(double real_dt_s, double time_scale) {
   // same product on both sides of the division), so scripted runs step once per frame.
   accumulator_steps_ += real_dt_s * time_scale / step_s_;
   window_real_s_ += real_dt_s;
-  // A frame a little short of a whole step still runs it (and owes the difference): a 60 Hz
-  // display's frame times jitter around one step, which would otherwise run 0, 2, 1, ... steps.
-  constexpr double kJitter = 0.1;
   pending_steps_ = static_cast<int>(std::floor(accumulator_steps_ + kJitter));
   pending_steps_ = std::min(pending_steps_, kMaxStepsPerFrame);
   return pending_steps_;
@@ -30,8 +34,8 @@ int SimClock::begin_frame(double real_dt_s, double time_scale) {
 void SimClock::end_frame(int steps_run) {
   steps_run = std::clamp(steps_run, 0, pending_steps_);
   accumulator_steps_ -= steps_run;
-  // Whatever could not run this frame is dropped, keeping only the fraction of a step.
-  accumulator_steps_ = std::min(accumulator_steps_, 1.0 - 1e-9);
+  // Whatever could not run this frame (the cap, the caller's budget) is dropped, not owed.
+  if (steps_run < pending_steps_ || accumulator_steps_ + kJitter >= 1.0) accumulator_steps_ = 0.0;
   window_sim_s_ += steps_run * step_s_;
   pending_steps_ = 0;
   if (window_real_s_ >= kMeasureWindow_s) {
