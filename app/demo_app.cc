@@ -234,7 +234,7 @@ Status DemoApp::render_scene(float real_dt_s) {
   return Status::Ok();
 }
 
-std::string DemoApp::hint() const {
+const char* DemoApp::hint() const {
   if (!session_ || !status_.empty()) return "";
   if (session_->frames_run() == 0 && paused_) {
     return "Paused: press Space (or untick pause) to start.\nThe new crowd appears on its first "
@@ -266,6 +266,10 @@ void DemoApp::write_report(const std::string& path) const {
     const ProjectedPoint p = camera_.project(c, size);
     exhibits.push_back({{"px", p.pixel.x + offset}, {"py", p.pixel.y}, {"in_front", p.in_front}});
   }
+  nlohmann::json clips = nlohmann::json::array();
+  for (const LocomotionClip& c : session_->library().clips) {
+    clips.push_back({{"name", c.clip.name}, {"speed_m_s", c.speed_m_s}});
+  }
   const glm::ivec2 fb = context_->framebuffer_size();
   const glm::ivec2 scene = scene_size();
   const nlohmann::json j = {
@@ -289,6 +293,8 @@ void DemoApp::write_report(const std::string& path) const {
         {"pitch_rad", camera_.pitch_rad},
         {"yaw_rad", camera_.yaw_rad}}},
       {"panel", {panel_rect_.x, panel_rect_.y, panel_rect_.z, panel_rect_.w}},
+      {"status", status_},
+      {"clips", clips},
       {"agents", agents},
       {"exhibits", exhibits}};
   std::ofstream out(path);

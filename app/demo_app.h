@@ -93,7 +93,7 @@ class DemoApp {
   void parse_inputs();
   void pick(glm::vec2 mouse_px);
   void select(int64_t id);
-  std::string hint() const;  // the note over an empty scene, or ""
+  const char* hint() const;  // the note over an empty scene, or ""
   glm::ivec2 scene_size() const;  // the window left of the panel
   glm::ivec2 view_size() const;   // the viewport of one lane (half the scene in compare)
   void write_report(const std::string& path) const;

@@ -36,15 +36,16 @@ void DemoApp::draw_overlay_text() {
   const bool split = session_->has_compare();
   const float half = static_cast<float>(view.x);
   const float base = ImGui::GetFontSize();
+  char text[160];
   if (split) {
-    const std::string right(mediator_mode_name(session_->params().mode));
+    const std::string_view right = mediator_mode_name(session_->params().mode);
+    std::snprintf(text, sizeof(text), "%.*s", static_cast<int>(right.size()), right.data());
     boxed_text(fg, ImVec2(12, 10), "naive", base * 1.4f, kWhite);
-    boxed_text(fg, ImVec2(half + 12, 10), right.c_str(), base * 1.4f, kWhite);
+    boxed_text(fg, ImVec2(half + 12, 10), text, base * 1.4f, kWhite);
     fg->AddLine(ImVec2(half, 0), ImVec2(half, static_cast<float>(view.y)),
                 IM_COL32(20, 20, 20, 255), 2.0f);
   }
   // Frames per second and whether the simulation keeps real time, bottom left of the view.
-  char text[160];
   const float bottom = static_cast<float>(view.y) - base - 10.0f;
   if (fps_ > 0.0f) {
     std::snprintf(text, sizeof(text), "%.0f FPS   sim step %.1f ms   H: help", fps_,
@@ -78,11 +79,11 @@ void DemoApp::draw_overlay_text() {
     label(session_->lane(), split ? half : 0.0f);
     if (split) label(session_->compare_lane(), 0.0f);
   }
-  const std::string h = hint();
-  if (!h.empty()) {
+  const char* h = hint();
+  if (*h) {
     const glm::ivec2 scene = scene_size();
     boxed_text(fg, ImVec2(0.5f * static_cast<float>(scene.x), 0.42f * static_cast<float>(scene.y)),
-               h.c_str(), base * 1.5f, IM_COL32(255, 230, 140, 255), true,
+               h, base * 1.5f, IM_COL32(255, 230, 140, 255), true,
                static_cast<float>(scene.x) - 40.0f);
   }
   if (help_) {

@@ -304,7 +304,7 @@ void DemoApp::panel_params() {
   bool changed = false;
   for (const ParamInfo& info : mediator_param_infos()) {
     ImGui::PushID(info.name);
-    row(std::string(param_label(info.name)).c_str());
+    row(param_label(info.name));
     const bool label_hovered = ImGui::IsItemHovered();
     if (info.kind == ParamInfo::Kind::kBool) {
       changed |= ImGui::Checkbox("##value", &(p.*info.b));

@@ -56,7 +56,7 @@ void FileBrowser::enter(const fs::path& folder) {
     if (name.empty() || name[0] == '.') continue;  // hidden files and folders
     std::error_code type_ec;
     if (e.is_directory(type_ec)) {
-      entries_.push_back({name, true});
+      entries_.push_back({name, "[folder] " + name, true});
       continue;
     }
     std::string ext = e.path().extension().string();
@@ -65,7 +65,7 @@ void FileBrowser::enter(const fs::path& folder) {
     });
     if (extensions_.empty() ||
         std::find(extensions_.begin(), extensions_.end(), ext) != extensions_.end()) {
-      entries_.push_back({name, false});
+      entries_.push_back({name, name, false});
     }
   }
   std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) {
@@ -112,8 +112,7 @@ bool FileBrowser::draw() {
   // Entering a folder rebuilds entries_: leave the loop and do it after.
   const Entry* enter_folder = nullptr;
   for (const Entry& e : entries_) {
-    const std::string label = e.folder ? "[folder] " + e.name : e.name;
-    if (ImGui::Selectable(label.c_str(), !e.folder && e.name == file_name_,
+    if (ImGui::Selectable(e.label.c_str(), !e.folder && e.name == file_name_,
                           ImGuiSelectableFlags_AllowDoubleClick)) {
       if (e.folder) {
         enter_folder = &e;

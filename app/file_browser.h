@@ -29,6 +29,7 @@ class FileBrowser {
  private:
   struct Entry {
     std::string name;
+    std::string label;  // what the list shows, built when the folder is read
     bool folder = false;
   };
   void enter(const std::filesystem::path& folder);

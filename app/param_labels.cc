@@ -1,10 +1,13 @@
 #include "app/param_labels.h"
 
+#include <string_view>
+
 namespace gk::app {
 namespace {
 
 struct Label {
-  std::string_view name, label;
+  std::string_view name;
+  const char* label;
 };
 // At most 26 characters: the panel's label column.
 constexpr Label kLabels[] = {
@@ -29,7 +32,7 @@ constexpr Label kLabels[] = {
 
 }  // namespace
 
-std::string_view param_label(std::string_view name) {
+const char* param_label(const char* name) {
   for (const Label& l : kLabels) {
     if (l.name == name) return l.label;
   }

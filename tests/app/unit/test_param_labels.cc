@@ -19,7 +19,7 @@ TEST(ParamLabels, EveryParameterHasAShortDistinctPlainLabel) {
     EXPECT_LE(label.size(), 26u) << label << " does not fit the panel's label column";
     EXPECT_TRUE(seen.insert(label).second) << "two parameters labelled " << label;
   }
-  EXPECT_EQ(param_label("not_a_parameter"), "not_a_parameter");
+  EXPECT_STREQ(param_label("not_a_parameter"), "not_a_parameter");
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -324,6 +325,49 @@ TEST(DemoShots, ExhibitsAppearInTheirColour) {
     shown += e["in_front"].get<bool>() && c.z > c.x + 50 && c.y > c.x + 40;
   }
   EXPECT_GE(shown, 2) << "the far wall's exhibits face the camera in teal";
+}
+
+// The panel driven by clicks at the pixels of its widgets in a 1280x720 window (the layout of
+// app/demo_panel.cc: if it changes, these positions must follow).
+TEST(DemoPanel, ANewScenarioComesWithItsOwnAgentCountAndAPausedOneSaysSo) {
+  GK_REQUIRE_DISPLAY();
+  // Gallery with 6 agents, paused; the scenario combo opened, "circle" chosen from its list.
+  const Shot s = run_demo("scenario_change",
+                          "--scenario gallery --agents 6 --frames 10 --input 1:key:space "
+                          "--input 3:click:1160,99 --input 6:click:1100,141",
+                          "1280x720");
+  EXPECT_EQ(s.report["scenario"].get<std::string>(), "circle") << s.report["status"];
+  EXPECT_EQ(s.report["agent_count"].get<int>(), 24) << "circle.json's default_agents, not 6";
+  EXPECT_NEAR(s.report["time_s"].get<double>(), 0.0, 1e-9);
+  EXPECT_NE(s.report["hint"].get<std::string>().find("Space"), std::string::npos);
+}
+
+TEST(DemoPanel, TheFolderBrowserLoadsAFolderOfClips) {
+  GK_REQUIRE_DISPLAY();
+  GK_REQUIRE_DATA("clips/bvh/ual_walk_loop.bvh");
+  const std::string data = test::data_dir();
+  // A data folder whose clips/ holds two of the shared BVH clips: the browser opens there.
+  const std::string root = test::scratch_dir("demo_browser");
+  std::filesystem::remove_all(root + "/clips");
+  std::filesystem::create_directories(root + "/clips");
+  for (const char* name : {"ual_walk_loop.bvh", "ual_jog_fwd_loop.bvh"}) {
+    std::filesystem::copy_file(data + "/clips/bvh/" + name, root + "/clips/" + name);
+  }
+  // Untick "built-in", press "browse...", then "this folder".
+  const std::string dir = test::scratch_dir("demo");
+  const test::CommandResult r = test::run_gaitkeeper(
+      "demo --size 1280x720 --scenario gallery --agents 6 --frames 12 --input 2:click:1082,145 "
+      "--input 5:click:940,191 --input 9:click:794,525 --report " + dir + "/browser.json",
+      "GAITKEEPER_DATA=" + root + " ");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream in(dir + "/browser.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["status"].get<std::string>(), "");
+  std::string names;
+  for (const auto& c : report["clips"]) names += c["name"].get<std::string>() + " ";
+  EXPECT_NE(names.find("ual_walk_loop"), std::string::npos) << names;
+  EXPECT_NE(names.find("ual_jog_fwd_loop"), std::string::npos) << names;
+  EXPECT_EQ(names.find("walk_slow"), std::string::npos) << "the built-in set is gone: " << names;
 }
 
 }  // namespace
