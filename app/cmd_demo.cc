@@ -26,7 +26,7 @@ void add_demo_command(CLI::App& app) {
   cmd->add_flag("--compare", options->compare, "Start in the naive | apm split screen");
   cmd->add_option("--overlay", options->overlays,
                   "Overlays on at start: velocity, theta, facing, planted, trails, paths, torso "
-                  "(the selected agent's torso fan), all (default: torso)");
+                  "(the selected agent's torso fan), all (default: torso; the showcase: trails)");
   cmd->add_option("--select", options->select, "Agent id to select and follow from the start");
   cmd->add_option("--pull-out", options->pull_out,
                   "With --select: at this simulated time [s] the camera pulls out to the whole "
@@ -42,7 +42,9 @@ void add_demo_command(CLI::App& app) {
   cmd->add_option("--screenshot", options->screenshot,
                   "With --frames: save the last frame of the window (panel included) as PNG");
   cmd->add_option("--report", options->report,
-                  "With --frames: write the panel rectangle and the agents' pixels as JSON");
+                  "With --frames (or after Esc): write the panel rectangle, the agents' and "
+                  "exhibits' pixels, the camera, simulated time, pause, help and selection as "
+                  "JSON");
   cmd->callback([options] {
     DemoApp demo(*options);
     const int code = demo.run();

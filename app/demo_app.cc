@@ -113,7 +113,10 @@ void DemoApp::restart() {
   camera_set_ = false;
   if (!ok) return;
   session_->set_params(keep);
-  if (showcase_ && crowd_.scenario == kShowcaseScenario && selected < 0) return;
+  if (showcase_ && crowd_.scenario == kShowcaseScenario && selected < 0) {
+    pick_showcase_ = true;  // the showcase's shot again: close on the door, then the room
+    return;
+  }
   if (selected >= 0) {
     selected_id_ = selected;  // the same seed brings the same agent back
     if (following) director_.follow(selected, camera_.distance_m, camera_.pitch_rad);
@@ -156,7 +159,7 @@ void DemoApp::simulate(double real_dt_s, bool scripted) {
     clock_.reset();
     return;
   }
-  if (paused_ || !status_.empty()) {
+  if (paused_) {
     clock_.reset();  // nothing is owed for the time spent paused
     return;
   }
