@@ -18,20 +18,33 @@ void add_demo_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "demo",
       "The interactive window: the crowd, a panel of parameters, overlays, live metrics "
-      "(also what `gaitkeeper` without arguments opens).");
+      "(also what `gaitkeeper` without arguments opens). Without --scenario it opens on the "
+      "showcase: the bottleneck's door, naive | apm, the camera on a queuing agent, then the "
+      "whole room. Keys: Space pause, H help, R restart, Esc quit.");
   add_crowd_options(cmd, &options->crowd, /*scenario_required=*/false);
   cmd->add_option("--size", options->size, "Window size WxH (default 1280x720)");
   cmd->add_flag("--compare", options->compare, "Start in the naive | apm split screen");
   cmd->add_option("--overlay", options->overlays,
-                  "Overlays on at start: velocity, theta, facing, planted, trails, paths, all");
+                  "Overlays on at start: velocity, theta, facing, planted, trails, paths, torso "
+                  "(the selected agent's torso fan), all (default: torso; the showcase: trails)");
   cmd->add_option("--select", options->select, "Agent id to select and follow from the start");
+  cmd->add_option("--pull-out", options->pull_out,
+                  "With --select: at this simulated time [s] the camera pulls out to the whole "
+                  "scene");
   cmd->add_option("--click", options->click,
                   "With --frames: left-click at window pixel X,Y on the last frame (picking)");
-  cmd->add_option("--frames", options->frames, "Run this many frames, then quit (scripted runs)");
+  cmd->add_option("--frames", options->frames,
+                  "Run this many frames (one simulation step each), then quit (scripted runs)");
+  cmd->add_option("--input", options->inputs,
+                  "With --frames: input at a frame, as a user would give it: FRAME:key:NAME "
+                  "(space, escape, h, r, ...), FRAME:click:X,Y or FRAME:wheel:X,Y,STEPS "
+                  "(repeatable)");
   cmd->add_option("--screenshot", options->screenshot,
                   "With --frames: save the last frame of the window (panel included) as PNG");
   cmd->add_option("--report", options->report,
-                  "With --frames: write the panel rectangle and the agents' pixels as JSON");
+                  "With --frames (or after Esc): write the panel rectangle, the agents' and "
+                  "exhibits' pixels, the camera, simulated time, pause, help and selection as "
+                  "JSON");
   cmd->callback([options] {
     DemoApp demo(*options);
     const int code = demo.run();

@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "app/camera_director.h"
 #include "app/commands.h"
 #include "app/crowd_session.h"
 #include "app/offscreen.h"
@@ -38,6 +39,7 @@ struct RenderOptions {
   std::string camera;
   std::vector<std::string> overlays;
   std::string follow;
+  std::string pull_out;
   std::string report;
 };
 
@@ -65,44 +67,72 @@ void apply_camera(const std::string& text, OrbitCamera* camera) {
 OverlayToggles parse_overlays(const std::vector<std::string>& names) {
   OverlayToggles t;
   for (const std::string& n : names) {
-    if (n == "velocity")
-      t.velocity = true;
-    else if (n == "theta")
-      t.theta = true;
-    else if (n == "facing")
-      t.facing = true;
-    else if (n == "planted")
-      t.planted = true;
-    else if (n == "trails")
-      t.trails = true;
-    else if (n == "paths")
-      t.paths = true;
-    else if (n == "all")
-      t = {true, true, true, true, true, true};
-    else {
-      fail(kCmd, 2,
-           "--overlay: expected velocity, theta, facing, planted, trails, paths or all, got '" + n +
-               "'");
+    if (!enable_overlay(n, &t)) {
+      fail(kCmd, 2, std::string("--overlay: expected ") + kOverlayNames + ", got '" + n + "'");
     }
   }
   return t;
 }
 
+// The torso fan's label above the followed agent's head, in the half (or whole) image at
+// `origin_x` of width `view.x`.
+void stamp_twist(const CrowdSession& s, const AnimationLane& lane, int64_t id,
+                 const OrbitCamera& camera, glm::ivec2 view, int origin_x, int scale,
+                 FrameCapture* capture, glm::ivec2 image) {
+  const std::optional<TorsoReadout> t = torso_readout(s, lane, id);
+  if (!t) return;
+  const ProjectedPoint p = camera.project(t->head, view);
+  if (!p.in_front) return;
+  char text[48];
+  std::snprintf(text, sizeof(text), "TWIST %.0f / LIMIT %.0f DEG", std::abs(t->twist_deg),
+                t->limit_deg);
+  const int w = label_width(text, scale);
+  const glm::ivec2 at(origin_x + static_cast<int>(p.pixel.x) - w / 2,
+                      static_cast<int>(p.pixel.y) - 9 * scale);
+  stamp_label(capture->mutable_rgba(), image, at, text, scale);
+}
+
 // Last frame's agents: ids, ground positions and where their hips (0.9 m up) land in the image,
 // so tests can look at the right pixels.
 void write_report(const std::string& path, const CrowdSession& s, const OrbitCamera& camera,
-                  glm::ivec2 size, bool split) {
+                  glm::ivec2 size, bool split, const Exhibits& exhibits, int64_t follow) {
   nlohmann::json agents = nlohmann::json::array();
   const glm::ivec2 view = split ? glm::ivec2(size.x / 2, size.y) : size;
-  for (const AgentDraw& d : s.lane().draw_span()) {
+  const auto draws = s.lane().draw_span();
+  for (size_t i = 0; i < draws.size(); ++i) {
+    const AgentDraw& d = draws[i];
     const ProjectedPoint p = camera.project(d.position + glm::vec3(0, 0.9f, 0), view);
-    agents.push_back({{"x", d.position.x},
+    agents.push_back({{"id", s.frame().ids[i]},
+                      {"x", d.position.x},
                       {"z", d.position.z},
                       {"px", p.pixel.x},
                       {"py", p.pixel.y},
                       {"in_front", p.in_front}});
   }
-  nlohmann::json j = {{"width", size.x}, {"height", size.y}, {"split", split}, {"agents", agents}};
+  nlohmann::json shown = nlohmann::json::array();
+  for (const glm::vec3& c : exhibits.canvas_centers) {
+    const ProjectedPoint p = camera.project(c, view);
+    shown.push_back({{"x", c.x}, {"z", c.z}, {"px", p.pixel.x}, {"py", p.pixel.y},
+                     {"in_front", p.in_front}});
+  }
+  nlohmann::json j = {{"width", size.x},
+                      {"height", size.y},
+                      {"split", split},
+                      {"camera",
+                       {{"target", {camera.target.x, camera.target.y, camera.target.z}},
+                        {"distance_m", camera.distance_m},
+                        {"fov_y_deg", camera.fov_y_deg}}},
+                      {"agents", agents},
+                      {"exhibits", shown}};
+  if (const std::optional<TorsoReadout> t = torso_readout(s, s.lane(), follow)) {
+    const ProjectedPoint head = camera.project(t->head, view);
+    j["followed"] = {{"id", follow},
+                     {"twist_deg", t->twist_deg},
+                     {"theta_deg", t->theta_deg},
+                     {"limit_deg", t->limit_deg},
+                     {"head_px", head.pixel.x},
+                     {"head_py", head.pixel.y}};
+  }
   std::ofstream out(path);
   out << j.dump(1) << "\n";
   if (!out) fail(kCmd, 1, path + ": cannot write the report");
@@ -120,6 +150,15 @@ void run_render(RenderOptions& o) {
   const OverlayToggles overlays = parse_overlays(o.overlays);
   const int64_t follow =
       o.follow.empty() ? -1 : parse_number<int>(kCmd, o.follow, "--follow", 0, 1 << 30);
+  if (overlays.torso && follow < 0 && o.overlays.end() != std::find(o.overlays.begin(),
+                                                                       o.overlays.end(), "torso")) {
+    fail(kCmd, 2, "--overlay torso draws the followed agent's torso fan: add --follow ID");
+  }
+  const double pull_out_s =
+      o.pull_out.empty() ? -1.0 : parse_number<float>(kCmd, o.pull_out, "--pull-out", 0.0f, 1e6f);
+  if (pull_out_s >= 0.0 && follow < 0) {
+    fail(kCmd, 2, "--pull-out: pulls out from a followed agent: add --follow ID");
+  }
   // Output paths are checked before the work starts, not after seconds of simulation.
   if (kind == OutputKind::kFolder) {
     if (Status s = check_output_folder(o.out, "--out"); !s.ok()) fail(kCmd, 2, s.message());
@@ -141,8 +180,30 @@ void run_render(RenderOptions& o) {
     scene.view->camera() = frame_bounds(session->bounds_min(), session->bounds_max(),
                                         {scene.size.x / 2, scene.size.y});
   }
-  if (!o.camera.empty()) apply_camera(o.camera, &scene.view->camera());
   const glm::ivec2 size = scene.size;
+  // With --follow the camera rides on the agent: --camera then sets its angles and distance.
+  CameraDirector director;
+  director.set_overview(scene.view->camera());
+  if (follow >= 0) {
+    OrbitCamera& c = scene.view->camera();
+    c.pitch_rad = kFollowPitch_rad;
+    c.distance_m = kFollowDistance_m;
+    if (!o.camera.empty()) {
+      apply_camera(o.camera, &c);
+      // The pull-out ends on the whole scene seen from the same side.
+      OrbitCamera overview = director.overview();
+      overview.yaw_rad = c.yaw_rad;
+      director.set_overview(overview);
+    }
+    director.follow(follow, c.distance_m, c.pitch_rad);
+    director.snap();
+    if (pull_out_s >= 0.0) director.pull_out_at(pull_out_s);
+  } else if (!o.camera.empty()) {
+    apply_camera(o.camera, &scene.view->camera());
+  }
+  const Exhibits exhibits =
+      make_exhibits(session->setup(), 0.5f * (session->bounds_min() + session->bounds_max()),
+                    scene.view->renderer().settings().wall_thickness_m);
   // Overlays are teaching aids: they stay visible through the bodies.
   scene.view->renderer().settings().lines_on_top = overlays.any();
 
@@ -179,8 +240,13 @@ void run_render(RenderOptions& o) {
     if (history) history->record(*session, session->lane(), kFrameTime_s);
     if (compare_history) compare_history->record(*session, session->compare_lane(), kFrameTime_s);
     const bool needed = kind != OutputKind::kPng || f == frames - 1;
+    if (!needed && follow < 0) continue;
+    session->collect();  // also the followed agent's drawn position
+    if (follow >= 0) {
+      director.update(session->crowd().time_s(), static_cast<float>(kFrameTime_s),
+                      followed_agent(*session, follow), &scene.view->camera());
+    }
     if (!needed) continue;
-    session->collect();
     scene.context->begin_frame();
     Status drawn;
     CrowdRenderer& r = scene.view->renderer();
@@ -202,6 +268,16 @@ void run_render(RenderOptions& o) {
     if (!drawn.ok()) fail(kCmd, 1, "frame " + std::to_string(f) + ": " + drawn.message());
     scene.context->finish_frame();
     if (Status s = capture.grab(size); !s.ok()) fail(kCmd, 1, s.message());
+    if (overlays.torso && follow >= 0) {
+      const glm::ivec2 view = split ? glm::ivec2(size.x / 2, size.y) : size;
+      const int scale = std::max(2, label_scale - 1);
+      stamp_twist(*session, session->lane(), follow, scene.view->camera(), view,
+                  split ? size.x / 2 : 0, scale, &capture, size);
+      if (split) {
+        stamp_twist(*session, session->compare_lane(), follow, scene.view->camera(), view, 0,
+                    scale, &capture, size);
+      }
+    }
     if (split) {
       stamp_label(capture.mutable_rgba(), size, {8 * label_scale, 8 * label_scale}, "NAIVE",
                   label_scale);
@@ -245,7 +321,9 @@ void run_render(RenderOptions& o) {
     if (status != 0)
       fail(kCmd, 1, "ffmpeg failed writing " + o.out + " (exit " + std::to_string(status) + ")");
   }
-  if (!o.report.empty()) write_report(o.report, *session, scene.view->camera(), size, split);
+  if (!o.report.empty()) {
+    write_report(o.report, *session, scene.view->camera(), size, split, exhibits, follow);
+  }
   std::printf("render: %d frames of %s (%d agents, %s%s) written to %s\n", frames,
               session->setup().scenario_name.c_str(), static_cast<int>(session->frame().size()),
               std::string(mediator_mode_name(session->params().mode)).c_str(),
@@ -271,8 +349,14 @@ void add_render_command(CLI::App& app) {
                   "yaw_deg,pitch_deg,distance_m[,target_x,target_z] (default: frames the "
                   "scenario in a 3/4 view)");
   cmd->add_option("--overlay", options->overlays,
-                  "Teaching overlays: velocity, theta, facing, planted, trails, paths, all");
-  cmd->add_option("--follow", options->follow, "Agent id to mark with a ring");
+                  "Teaching overlays: velocity, theta, facing, planted, trails, paths, torso "
+                  "(the followed agent's torso fan), all");
+  cmd->add_option("--follow", options->follow,
+                  "Agent id to follow: a ring at its feet, the camera close on it (--camera then "
+                  "sets yaw, pitch and distance)");
+  cmd->add_option("--pull-out", options->pull_out,
+                  "With --follow: at this simulated time [s] the camera pulls out to the whole "
+                  "scene");
   cmd->add_option("--report", options->report,
                   "Write the last frame's agent positions and image pixels as JSON");
   cmd->callback([options] { run_render(*options); });

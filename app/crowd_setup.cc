@@ -160,6 +160,7 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
   src.scenario_name = loaded->name;
   src.agents = num_agents;
   src.walls = scenario.walls;
+  src.attention_targets = scenario.attention_targets;
   src.bounds_min = scenario.bounds_min;
   src.bounds_max = scenario.bounds_max;
   src.has_bounds = true;

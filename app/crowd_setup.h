@@ -60,6 +60,7 @@ struct CrowdSetup {
   // Geometry for the renderer and the camera; a replayed file has no walls and its bounds are
   // those of its tracks (estimated from the first frames by the session).
   std::vector<WallSegment> walls;
+  std::vector<AttentionTarget> attention_targets;  // exhibits the agents look at (scaled)
   glm::vec2 bounds_min{-10.0f}, bounds_max{10.0f};
   bool has_bounds = false;
   // A replayed file's pedestrian ids (sorted); empty for a simulated crowd, whose ids are

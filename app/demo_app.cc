@@ -26,32 +26,36 @@ float ms_since(Clock::time_point t) {
 }
 
 constexpr const char* kNoDisplay = "no display: use `gaitkeeper render` or `gaitkeeper bench`";
+// Wall time one frame may spend on simulation steps before the rest is dropped (SimClock): the
+// window keeps drawing (and answering) on a machine that cannot simulate in real time.
+constexpr float kStepBudget_ms = 40.0f;
 
 }  // namespace
 
 DemoApp::DemoApp(DemoOptions options) : options_(std::move(options)) {
   crowd_ = options_.crowd;
   crowd_.command = "demo";
-  // The gallery shows the mediator at a glance: visitors walk one way and look at the exhibits.
-  if (crowd_.scenario.empty()) crowd_.scenario = "gallery";
+  showcase_ = crowd_.scenario.empty();
+  if (showcase_) {
+    // The point at a glance: feet at a crowded door, naive beside apm, trails on the ground.
+    crowd_.scenario = kShowcaseScenario;
+    options_.compare = true;
+    if (options_.overlays.empty()) options_.overlays = {"trails"};
+    pick_showcase_ = options_.select.empty();
+  } else if (options_.overlays.empty()) {
+    overlays_.torso = true;  // only the selected agent has a fan: nothing shows until a click
+  }
   compare_ = options_.compare;
   if (ends_with(crowd_.scenario, ".txt")) sim_kind_ = 2, replay_path_ = crowd_.scenario;
   if (crowd_.sim == "detour") sim_kind_ = 1;
   builtin_clips_ = crowd_.clips.empty();
   if (!builtin_clips_) clip_path_ = crowd_.clips.front();
+  agents_edited_ = !crowd_.agents.empty();
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(scenario_dir(), ec)) {
     if (e.path().extension() == ".json") scenario_names_.push_back(e.path().stem().string());
   }
   std::sort(scenario_names_.begin(), scenario_names_.end());
-  for (const std::string& n : options_.overlays) {
-    overlays_.velocity |= n == "velocity" || n == "all";
-    overlays_.theta |= n == "theta" || n == "all";
-    overlays_.facing |= n == "facing" || n == "all";
-    overlays_.planted |= n == "planted" || n == "all";
-    overlays_.trails |= n == "trails" || n == "all";
-    overlays_.paths |= n == "paths" || n == "all";
-  }
 }
 
 DemoApp::~DemoApp() {
@@ -86,13 +90,37 @@ bool DemoApp::rebuild() {
   compare_history_.emplace(*session_, capacity);
   metrics_.reset();
   compare_metrics_.reset();
+  clock_.reset();
   selected_id_ = -1;
-  follow_ = false;
+  director_.stop_following();
   agents_ = static_cast<int>(session_->setup().agents);
-  if (!camera_set_) {
-    camera_ = frame_bounds(session_->bounds_min(), session_->bounds_max(), view_size());
-  }
+  if (!camera_set_) overview_yaw_.reset();
+  director_.set_overview(frame_bounds(session_->bounds_min(), session_->bounds_max(), view_size()));
+  if (!camera_set_) camera_ = director_.overview();
   return true;
+}
+
+void DemoApp::restart() {
+  restart_requested_ = false;
+  const MediatorParams keep = session_->params();
+  const int64_t selected = selected_id_;
+  const bool following = director_.following();
+  crowd_.sets.clear();
+  crowd_.params_file.clear();
+  crowd_.mode = std::string(mediator_mode_name(keep.mode));
+  camera_set_ = true;  // the same place: keep looking where the user looked
+  const bool ok = rebuild();
+  camera_set_ = false;
+  if (!ok) return;
+  session_->set_params(keep);
+  if (showcase_ && crowd_.scenario == kShowcaseScenario && selected < 0) {
+    pick_showcase_ = true;  // the showcase's shot again: close on the door, then the room
+    return;
+  }
+  if (selected >= 0) {
+    selected_id_ = selected;  // the same seed brings the same agent back
+    if (following) director_.follow(selected, camera_.distance_m, camera_.pitch_rad);
+  }
 }
 
 glm::ivec2 DemoApp::scene_size() const {
@@ -105,14 +133,11 @@ glm::ivec2 DemoApp::view_size() const {
   return session_ && session_->has_compare() ? glm::ivec2(scene.x / 2, scene.y) : scene;
 }
 
-void DemoApp::simulate() {
-  if (paused_ && !step_once_) return;
-  step_once_ = false;
-  const double dt = kFrameTime_s * time_scale_;
+bool DemoApp::step_once(double dt) {
   if (Status s = session_->step(dt); !s.ok()) {
     status_ = "simulation stopped: " + s.message();
     paused_ = true;
-    return;
+    return false;
   }
   history_->record(*session_, session_->lane(), static_cast<float>(dt));
   if (session_->has_compare()) {
@@ -124,11 +149,59 @@ void DemoApp::simulate() {
   metrics_.record_stage(LiveStage::kSim, static_cast<float>(t.sim_ms));
   metrics_.record_stage(LiveStage::kMediator, static_cast<float>(t.mediator_ms));
   metrics_.record_stage(LiveStage::kPose, static_cast<float>(t.pose_ms));
+  return true;
 }
 
-Status DemoApp::render_scene() {
+void DemoApp::simulate(double real_dt_s, bool scripted) {
+  if (step_requested_) {
+    step_requested_ = false;
+    step_once(SimClock::step_s(time_scale_));
+    clock_.reset();
+    return;
+  }
+  if (paused_) {
+    clock_.reset();  // nothing is owed for the time spent paused
+    return;
+  }
+  const int steps = clock_.begin_frame(real_dt_s, time_scale_);
+  const auto start = Clock::now();
+  int ran = 0;
+  while (ran < steps) {
+    // A scripted run is reproducible: every step it asked for runs.
+    if (!scripted && ran > 0 && ms_since(start) > kStepBudget_ms) break;
+    if (!step_once(SimClock::step_s(time_scale_))) break;
+    ++ran;
+  }
+  clock_.end_frame(ran);
+  if (pick_showcase_ && session_->frame().size() > 0) {
+    // The agent nearest the middle of the room: it queues at the door for several seconds.
+    pick_showcase_ = false;
+    const glm::vec2 centre = 0.5f * (session_->bounds_min() + session_->bounds_max());
+    const AgentFrame& frame = session_->frame();
+    float best = 1e30f;
+    int64_t id = -1;
+    for (size_t i = 0; i < frame.size(); ++i) {
+      const float d = glm::length(frame.positions[i] - centre);
+      if (d < best) best = d, id = frame.ids[i];
+    }
+    if (id >= 0) {
+      selected_id_ = id;
+      camera_.yaw_rad = kShowcaseYaw_rad;
+      overview_yaw_ = kShowcaseYaw_rad;
+      director_.follow(id);
+      director_.snap();
+      director_.pull_out_at(kShowcasePullOut_s);
+    }
+  }
+}
+
+Status DemoApp::render_scene(float real_dt_s) {
   session_->collect();
-  follow_selected();
+  OrbitCamera overview = frame_bounds(session_->bounds_min(), session_->bounds_max(), view_size());
+  if (overview_yaw_) overview.yaw_rad = *overview_yaw_;
+  director_.set_overview(overview);
+  director_.update(session_->crowd().time_s(), real_dt_s,
+                   followed_agent(*session_, director_.followed_id()), &camera_);
   view_->camera() = camera_;
   view_->renderer().settings().lines_on_top = overlays_.any();
   context_->begin_frame();
@@ -164,55 +237,16 @@ Status DemoApp::render_scene() {
   return Status::Ok();
 }
 
-void DemoApp::follow_selected() {
-  if (!follow_ || selected_id_ < 0) return;
-  const AgentFrame& frame = session_->frame();
-  const auto draws = session_->lane().draw_span();
-  for (size_t i = 0; i < draws.size(); ++i) {
-    if (frame.ids[i] != selected_id_) continue;
-    // Eased so that the stride's sway does not shake the view.
-    camera_.target = glm::mix(camera_.target, draws[i].position + glm::vec3(0, 0.9f, 0), 0.15f);
-    return;
+const char* DemoApp::hint() const {
+  if (!session_ || !status_.empty()) return "";
+  if (session_->frames_run() == 0 && paused_) {
+    return "Paused: press Space (or untick pause) to start.\nThe new crowd appears on its first "
+           "step.";
   }
-  follow_ = false;  // the agent left the scene
-}
-
-void DemoApp::pick(glm::vec2 mouse_px) {
-  glm::vec2 px = mouse_px;
-  const glm::ivec2 size = view_size();
-  if (session_->has_compare() && px.x >= size.x) px.x -= static_cast<float>(size.x);
-  const Ray ray = camera_.pick_ray(px, size);
-  const AgentFrame& frame = session_->frame();
-  const auto draws = session_->lane().draw_span();
-  float best = 0.6f;  // [m] from the ray to the body's axis point at hip height
-  int64_t picked = -1;
-  for (size_t i = 0; i < draws.size(); ++i) {
-    const glm::vec3 c = draws[i].position + glm::vec3(0, 0.9f, 0);
-    const float along = glm::dot(c - ray.origin, ray.direction);
-    if (along <= 0.0f) continue;
-    const float d = glm::length(c - (ray.origin + along * ray.direction));
-    if (d < best) best = d, picked = frame.ids[i];
+  if (session_->frames_run() > 0 && session_->frame().size() == 0) {
+    return "Nobody is left in the scene: press R to restart it.";
   }
-  selected_id_ = picked;
-  follow_ = picked >= 0;
-  // Close enough to see the feet of the followed agent.
-  if (follow_) camera_.distance_m = std::min(camera_.distance_m, 9.0f);
-}
-
-void DemoApp::handle_input() {
-  const ImGuiIO& io = ImGui::GetIO();
-  if (io.WantCaptureMouse) return;
-  const glm::vec2 mouse(io.MousePos.x, io.MousePos.y);
-  const glm::vec2 delta(io.MouseDelta.x, io.MouseDelta.y);
-  if (ImGui::IsMouseDragging(ImGuiMouseButton_Right, 0.0f)) {
-    camera_.orbit(-delta.x * 0.006f, delta.y * 0.006f);
-  }
-  if (ImGui::IsMouseDragging(ImGuiMouseButton_Middle, 0.0f)) {
-    camera_.pan(delta, view_size());
-    follow_ = false;
-  }
-  if (io.MouseWheel != 0.0f) camera_.zoom(std::pow(0.88f, io.MouseWheel));
-  if (ImGui::IsMouseClicked(ImGuiMouseButton_Left)) pick(mouse);
+  return "";
 }
 
 void DemoApp::write_report(const std::string& path) const {
@@ -227,15 +261,45 @@ void DemoApp::write_report(const std::string& path) const {
                       {"py", p.pixel.y},
                       {"in_front", p.in_front}});
   }
+  nlohmann::json exhibits = nlohmann::json::array();
+  const Exhibits shown =
+      make_exhibits(session_->setup(), 0.5f * (session_->bounds_min() + session_->bounds_max()),
+                    view_->renderer().settings().wall_thickness_m);
+  for (const glm::vec3& c : shown.canvas_centers) {
+    const ProjectedPoint p = camera_.project(c, size);
+    exhibits.push_back({{"px", p.pixel.x + offset}, {"py", p.pixel.y}, {"in_front", p.in_front}});
+  }
+  nlohmann::json clips = nlohmann::json::array();
+  for (const LocomotionClip& c : session_->library().clips) {
+    clips.push_back({{"name", c.clip.name}, {"speed_m_s", c.speed_m_s}});
+  }
   const glm::ivec2 fb = context_->framebuffer_size();
   const glm::ivec2 scene = scene_size();
-  const nlohmann::json j = {{"scene_width", scene.x},
-                            {"width", fb.x},
-                            {"height", fb.y},
-                            {"compare", session_->has_compare()},
-                            {"selected", selected_id_},
-                            {"panel", {panel_rect_.x, panel_rect_.y, panel_rect_.z, panel_rect_.w}},
-                            {"agents", agents}};
+  const nlohmann::json j = {
+      {"scene_width", scene.x},
+      {"width", fb.x},
+      {"height", fb.y},
+      {"compare", session_->has_compare()},
+      {"scenario", session_->setup().scenario_name},
+      {"agent_count", session_->setup().agents},
+      {"frames", frames_drawn_},
+      {"time_s", session_->crowd().time_s()},
+      {"paused", paused_},
+      {"help", help_},
+      {"help_rect", {help_rect_.x, help_rect_.y, help_rect_.z, help_rect_.w}},
+      {"hint", hint()},
+      {"selected", selected_id_},
+      {"following", director_.following()},
+      {"camera",
+       {{"target", {camera_.target.x, camera_.target.y, camera_.target.z}},
+        {"distance_m", camera_.distance_m},
+        {"pitch_rad", camera_.pitch_rad},
+        {"yaw_rad", camera_.yaw_rad}}},
+      {"panel", {panel_rect_.x, panel_rect_.y, panel_rect_.z, panel_rect_.w}},
+      {"status", status_},
+      {"clips", clips},
+      {"agents", agents},
+      {"exhibits", exhibits}};
   std::ofstream out(path);
   out << j.dump(1) << "\n";
   if (!out) fail("demo", 1, path + ": cannot write the report");
@@ -252,6 +316,23 @@ int DemoApp::run() {
   const int frames_to_run =
       options_.frames.empty() ? -1
                               : parse_number<int>("demo", options_.frames, "--frames", 1, 1 << 30);
+  const bool scripted = frames_to_run > 0;
+  for (const std::string& n : options_.overlays) {
+    if (!enable_overlay(n, &overlays_)) {
+      fail("demo", 2, std::string("--overlay: expected ") + kOverlayNames + ", got '" + n + "'");
+    }
+  }
+  const float pull_out_s =
+      options_.pull_out.empty()
+          ? -1.0f
+          : parse_number<float>("demo", options_.pull_out, "--pull-out", 0.0f, 1e6f);
+  if (pull_out_s >= 0.0f && options_.select.empty()) {
+    fail("demo", 2, "--pull-out: pulls out from a followed agent: add --select ID");
+  }
+  parse_inputs();
+  if (!scripted && (!scripted_.empty() || !options_.click.empty())) {
+    fail("demo", 2, "--input and --click script a run: add --frames N");
+  }
   // Output paths are checked before the window opens and the frames run.
   check_output_file_option("demo", options_.screenshot, "--screenshot");
   check_output_file_option("demo", options_.report, "--report");
@@ -260,7 +341,7 @@ int DemoApp::run() {
   co.height = size.y;
   co.title = "Gaitkeeper - crowd animation without foot skating";
   // A scripted run (tests, pictures) must not wait for the display's refresh.
-  co.vsync = frames_to_run < 0;
+  co.vsync = !scripted;
   auto context = GlContext::create_window(co);
   if (!context.ok()) {
     std::fprintf(stderr, "gaitkeeper: %s (%s)\n", kNoDisplay, context.message().c_str());
@@ -273,10 +354,12 @@ int DemoApp::run() {
     return 2;
   }
   if (!options_.select.empty()) {
-    selected_id_ = parse_number<int>("demo", options_.select, "--select", 0, 1 << 30);
-    check_agent_id("demo", session_->setup(), selected_id_, "--select");
-    follow_ = true;
-    camera_.distance_m = std::min(camera_.distance_m, 9.0f);
+    const int64_t id = parse_number<int>("demo", options_.select, "--select", 0, 1 << 30);
+    check_agent_id("demo", session_->setup(), id, "--select");
+    selected_id_ = id;
+    director_.follow(id);
+    director_.snap();
+    if (pull_out_s >= 0.0f) director_.pull_out_at(pull_out_s);
   }
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -286,36 +369,41 @@ int DemoApp::run() {
   ImGui_ImplOpenGL3_Init("#version 330 core");
   imgui_ready_ = true;
 
-  int frame = 0;
-  while (!context_->should_close()) {
+  auto last_frame = Clock::now();
+  while (!context_->should_close() && !quit_) {
     const auto frame_start = Clock::now();
+    // A scripted run's frames are 1/60 s apart whatever the machine: reproducible pictures.
+    const float wall_dt = std::chrono::duration<float>(frame_start - last_frame).count();
+    const float real_dt = scripted ? static_cast<float>(kFrameTime_s) : wall_dt;
+    last_frame = frame_start;
     context_->poll_events();
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
+    feed_scripted_input(frames_drawn_);
     ImGui::NewFrame();
     draw_panel();
-    if (session_->has_compare()) {
-      // Which half is which, on top of the 3D view.
-      ImDrawList* fg = ImGui::GetForegroundDrawList();
-      const float half = static_cast<float>(view_size().x);
-      const std::string right(mediator_mode_name(session_->params().mode));
-      fg->AddRectFilled(ImVec2(8, 8), ImVec2(70, 30), IM_COL32(0, 0, 0, 150));
-      fg->AddText(ImVec2(14, 11), IM_COL32(255, 255, 255, 255), "naive");
-      fg->AddRectFilled(ImVec2(half + 8, 8), ImVec2(half + 70, 30), IM_COL32(0, 0, 0, 150));
-      fg->AddText(ImVec2(half + 14, 11), IM_COL32(255, 255, 255, 255), right.c_str());
-      fg->AddLine(ImVec2(half, 0), ImVec2(half, static_cast<float>(view_size().y)),
-                  IM_COL32(20, 20, 20, 255), 2.0f);
-    }
+    handle_browser();
     handle_input();
-    simulate();
-    if (Status s = render_scene(); !s.ok()) {
+    if (quit_) break;
+    if (restart_requested_) restart();
+    simulate(real_dt, scripted);
+    if (Status s = render_scene(real_dt); !s.ok()) {
       std::fprintf(stderr, "gaitkeeper demo: %s\n", s.message().c_str());
       return 1;
     }
+    draw_overlay_text();
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-    ++frame;
-    if (frames_to_run > 0 && frame >= frames_to_run) {
+    ++frames_drawn_;
+    // Measured on the wall clock, also in scripted runs (whose simulated frames are fixed).
+    fps_window_s_ += wall_dt;
+    ++fps_frames_;
+    if (fps_window_s_ >= 0.5f) {
+      fps_ = static_cast<float>(fps_frames_) / fps_window_s_;
+      fps_window_s_ = 0.0f;
+      fps_frames_ = 0;
+    }
+    if (scripted && frames_drawn_ >= frames_to_run) {
       if (!options_.screenshot.empty()) {
         context_->finish_frame();
         Status s = capture_.grab(context_->framebuffer_size());
@@ -338,12 +426,13 @@ int DemoApp::run() {
         if (y < 0.0f) fail("demo", 2, "--click: expected X,Y in window pixels");
         pick({x, y});
       }
-      if (!options_.report.empty()) write_report(options_.report);
       break;
     }
     context_->present();
     metrics_.record_stage(LiveStage::kFrame, ms_since(frame_start));
   }
+  // Also after Esc, so a scripted run can show that it quit.
+  if (!options_.report.empty()) write_report(options_.report);
   return 0;
 }
 

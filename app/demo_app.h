@@ -1,19 +1,30 @@
 #pragma once
 // The interactive demo: a GLFW window with the crowd and a Dear ImGui panel. The panel rebuilds
 // the session when the crowd changes (scenario, simulator, agents, clips), sets mediator
-// parameters live, pauses / steps / scales time, toggles overlays and the naive | apm split
-// screen, and plots live metrics and stage timings. Camera: right drag orbits, middle drag pans,
-// the wheel zooms, a left click on an agent follows it.
+// parameters live (and saves / loads them as JSON), pauses / steps / scales time, toggles overlays
+// and the naive | apm split screen, and plots live metrics and stage timings. The simulation runs
+// on a fixed step decoupled from the draw rate (SimClock) and says when it cannot keep real time.
+//
+// Camera: right drag orbits, middle drag pans, the wheel zooms toward the cursor, a left click
+// on an agent selects and follows it (CameraDirector). Keys: Space pauses, H shows the help,
+// R restarts the crowd, Esc quits.
+//
+// Without --scenario the window opens on the showcase: the bottleneck's door in the naive | apm
+// split with foot trails, the camera close on an agent queuing at the door, pulling out to the
+// whole room after kShowcasePullOut_s of simulated time.
 
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "app/camera_director.h"
 #include "app/crowd_session.h"
+#include "app/file_browser.h"
 #include "app/live_metrics.h"
 #include "app/overlays.h"
 #include "app/scene_view.h"
+#include "app/sim_clock.h"
 #include "render/frame_capture.h"
 #include "render/gl_context.h"
 
@@ -24,16 +35,26 @@ struct DemoOptions {
   std::string size = "1280x720";
   bool compare = false;
   std::vector<std::string> overlays;
+  std::string pull_out;  // seconds of simulated time, then the camera pulls out (with --select)
   // For tests and pictures: run this many frames, save the window (panel included), quit.
+  // Scripted runs step the simulation once per frame, so they are reproducible.
   std::string frames;
   std::string screenshot;
   std::string select;  // agent id to select and follow from the start
   std::string click;   // "X,Y": a left click at this window pixel on the last frame (tests)
+  // "FRAME:key:NAME", "FRAME:click:X,Y", "FRAME:wheel:X,Y,STEPS": input fed to Dear ImGui at the
+  // start of a frame, exactly where a real key press, click or wheel turn arrives (tests).
+  std::vector<std::string> inputs;
   std::string report;  // JSON: panel rectangle and the agents' pixels on the last frame
 };
 
 // Width of the panel docked at the right edge of the window [px]; the 3D view fills the rest.
 inline constexpr int kPanelWidth_px = 380;
+// The showcase: the scenario, the point whose nearest agent is followed, and when it pulls out.
+inline constexpr const char* kShowcaseScenario = "bottleneck";
+inline constexpr float kShowcasePullOut_s = 10.0f;
+// Seen from the side (the eye south of the agent): feet walking toward the door cross the view.
+inline constexpr float kShowcaseYaw_rad = 3.14159265f;
 
 class DemoApp {
  public:
@@ -43,18 +64,36 @@ class DemoApp {
   int run();
 
  private:
+  struct ScriptedInput {
+    int frame = 0;
+    enum class Kind { kKey, kClick, kWheel } kind = Kind::kKey;
+    int key = 0;  // GLFW key code
+    glm::vec2 pos{0.0f};
+    float wheel = 0.0f;
+  };
+
   bool rebuild();  // a new session from crowd_; false (message kept) when the options are bad
-  void simulate();
-  Status render_scene();
+  void restart();  // rebuild with the same options, keeping the parameters (R)
+  void simulate(double real_dt_s, bool scripted);
+  bool step_once(double dt_s);
+  Status render_scene(float real_dt_s);
+  void draw_overlay_text();  // app/demo_hud.cc: labels, twist, notes, hints, help
+  void draw_help();
   void draw_panel();  // app/demo_panel.cc
   void panel_crowd();
+  void apply_crowd();  // rebuild from the crowd the panel shows, keeping the parameters
+  void panel_clips();
   void panel_params();
   void panel_view();
   void panel_metrics();
   void panel_agent();
-  void handle_input();
+  void handle_browser();
+  void handle_input();  // app/demo_input.cc
+  void feed_scripted_input(int frame);
+  void parse_inputs();
   void pick(glm::vec2 mouse_px);
-  void follow_selected();
+  void select(int64_t id);
+  const char* hint() const;  // the note over an empty scene, or ""
   glm::ivec2 scene_size() const;  // the window left of the panel
   glm::ivec2 view_size() const;   // the viewport of one lane (half the scene in compare)
   void write_report(const std::string& path) const;
@@ -62,6 +101,7 @@ class DemoApp {
   DemoOptions options_;
   CrowdOptions crowd_;  // what the panel edits; applied by rebuild()
   std::string status_;  // last rebuild error, shown in the panel
+  std::string note_;    // last parameter file saved / loaded
   std::unique_ptr<GlContext> context_;
   std::unique_ptr<CrowdSession> session_;
   std::unique_ptr<SceneView> view_;
@@ -70,22 +110,38 @@ class DemoApp {
   LiveMetrics compare_metrics_;  // the naive lane, shown beside the primary in compare mode
   OverlayToggles overlays_;
   OrbitCamera camera_;
+  CameraDirector director_;
+  SimClock clock_;
   bool camera_set_ = false;
+  bool showcase_ = false;         // opened without --scenario
+  bool pick_showcase_ = false;    // follow the showcase agent once the crowd has its first frame
+  std::optional<float> overview_yaw_;  // the overview's yaw when not frame_bounds' 3/4 view
   bool paused_ = false;
-  bool step_once_ = false;
+  bool step_requested_ = false;
+  bool help_ = false;
+  bool help_focused_ = false;  // the help window was brought to the front since it opened
+  bool quit_ = false;
+  bool restart_requested_ = false;
   float time_scale_ = 1.0f;
   bool compare_ = false;
   int64_t selected_id_ = -1;
-  bool follow_ = false;
   bool imgui_ready_ = false;
-  glm::vec2 last_mouse_{0.0f};
   std::vector<std::string> scenario_names_;
   int sim_kind_ = 0;  // 0 social, 1 detour, 2 replay of a trajectory file
   std::string replay_path_;
   bool builtin_clips_ = true;
   std::string clip_path_;
   int agents_ = 0;
+  bool agents_edited_ = false;  // the count typed in the panel overrides the scenario's default
+  std::string params_path_ = "gaitkeeper_params.json";
+  FileBrowser browser_;
+  std::vector<ScriptedInput> scripted_;
+  int frames_drawn_ = 0;
+  float fps_ = 0.0f;  // drawn frames per second over the last half second
+  float fps_window_s_ = 0.0f;
+  int fps_frames_ = 0;
   glm::vec4 panel_rect_{0.0f};  // x, y, w, h [px] of the panel window, for the report
+  glm::vec4 help_rect_{0.0f};   // x, y, w, h [px] of the help window while shown
   FrameCapture capture_;
 };
 

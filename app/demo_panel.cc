@@ -1,22 +1,37 @@
-// The demo's Dear ImGui panel: crowd (rebuilds the session), mediator parameters (live), view and
+// The demo's Dear ImGui panel: crowd (rebuilds the session; files picked with a folder browser),
+// the loaded clips, mediator parameters (live, in plain words; saved and loaded as JSON), view and
 // overlays, live metrics with plots, per-stage timings, and the selected agent's animation state.
+#include <cfloat>
+#include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <string>
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
 #include "app/demo_app.h"
+#include "app/param_labels.h"
 
 namespace gk::app {
 namespace {
 
 constexpr float kPanelWidth = static_cast<float>(kPanelWidth_px);
+constexpr float kLabelColumn = 172.0f;  // [px] plain-language labels left, widgets right
 constexpr const char* kSims[] = {"social forces", "DetourCrowd", "replay a trajectory file"};
 constexpr const char* kModes[] = {"naive", "rate", "apm"};
+enum BrowseFor : int { kBrowseClips, kBrowseTrajectory, kBrowseLoadParams, kBrowseSaveParams };
 
 void help_marker(const char* text) {
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
+}
+
+// A label in the left column; the next widget fills the rest of the row.
+void row(const char* label) {
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted(label);
+  ImGui::SameLine(kLabelColumn);
+  ImGui::SetNextItemWidth(-FLT_MIN);
 }
 
 }  // namespace
@@ -30,48 +45,72 @@ void DemoApp::draw_panel() {
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   panel_rect_ = glm::vec4(pos.x, pos.y, size.x, size.y);
-  if (!status_.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.3f, 1.0f), "%s", status_.c_str());
+  if (!status_.empty()) {
+    ImGui::PushTextWrapPos(0.0f);
+    ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.3f, 1.0f), "%s", status_.c_str());
+    ImGui::PopTextWrapPos();
+  }
+  ImGui::TextDisabled("Space pause, H help, R restart, Esc quit");
   if (ImGui::CollapsingHeader("Crowd", ImGuiTreeNodeFlags_DefaultOpen)) panel_crowd();
   if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) panel_view();
   if (ImGui::CollapsingHeader("Metrics", ImGuiTreeNodeFlags_DefaultOpen)) panel_metrics();
   if (ImGui::CollapsingHeader("Selected agent", ImGuiTreeNodeFlags_DefaultOpen)) panel_agent();
+  if (ImGui::CollapsingHeader("Clips")) panel_clips();
   if (ImGui::CollapsingHeader("Mediator parameters")) panel_params();
   ImGui::End();
 }
 
 void DemoApp::panel_crowd() {
   bool changed = false;
-  if (ImGui::Combo("simulator", &sim_kind_, kSims, 3)) changed = sim_kind_ != 2;
+  row("simulator");
+  if (ImGui::Combo("##simulator", &sim_kind_, kSims, 3)) changed = sim_kind_ != 2;
   if (sim_kind_ == 2) {
-    ImGui::InputText("file", &replay_path_);
+    row("trajectory file");
+    ImGui::InputText("##trajectory", &replay_path_);
     help_marker(
         "An ETH/UCY trajectory .txt file (frame id x y), e.g. "
         "../shared/data/trajectories/zara1/crowds_zara01.txt");
-    if (ImGui::Button("load trajectory")) changed = true;
-  } else if (ImGui::BeginCombo("scenario", crowd_.scenario.c_str())) {
-    for (const std::string& name : scenario_names_) {
-      if (ImGui::Selectable(name.c_str(), name == crowd_.scenario)) {
-        crowd_.scenario = name;
-        changed = true;
-      }
+    if (ImGui::Button("browse...##trajectory")) {
+      browser_.open("Trajectory file", browse_start(replay_path_, "trajectories"), {".txt"},
+                    FileBrowser::Mode::kOpen, false, kBrowseTrajectory);
     }
-    ImGui::EndCombo();
-  }
-  if (sim_kind_ != 2) {
-    ImGui::InputInt("agents", &agents_, 10, 100);
+    ImGui::SameLine();
+    if (ImGui::Button("load trajectory")) changed = true;
+  } else {
+    row("scenario");
+    if (ImGui::BeginCombo("##scenario", crowd_.scenario.c_str())) {
+      for (const std::string& name : scenario_names_) {
+        if (ImGui::Selectable(name.c_str(), name == crowd_.scenario)) {
+          crowd_.scenario = name;
+          agents_edited_ = false;  // a new scenario comes with its own agent count
+          changed = true;
+        }
+      }
+      ImGui::EndCombo();
+    }
+    row("agents");
+    ImGui::InputInt("##agents", &agents_, 10, 100);
     help_marker(
-        "Agent count; the scenario's geometry grows to keep its spawn density. Applied "
-        "when you leave the field.");
-    if (ImGui::IsItemDeactivatedAfterEdit()) changed = true;
+        "Agent count (a new scenario starts with its own default); the scenario's geometry grows "
+        "to keep its spawn density. Applied when you leave the field.");
+    if (ImGui::IsItemDeactivatedAfterEdit()) changed = true, agents_edited_ = true;
   }
-  if (ImGui::Checkbox("built-in clips", &builtin_clips_) && builtin_clips_) changed = true;
+  row("clips");
+  if (ImGui::Checkbox("built-in##clips", &builtin_clips_) && builtin_clips_) changed = true;
   if (!builtin_clips_) {
-    ImGui::InputText("clips", &clip_path_);
+    ImGui::SetNextItemWidth(-FLT_MIN);
+    ImGui::InputText("##clip_path", &clip_path_);
     help_marker("A BVH/glTF/GLB file or a folder of them, e.g. ../shared/data/clips/bvh");
+    if (ImGui::Button("browse...##clips")) {
+      browser_.open("Clip file or folder", browse_start(clip_path_, "clips"),
+                    {".bvh", ".gltf", ".glb"}, FileBrowser::Mode::kOpen, true, kBrowseClips);
+    }
+    ImGui::SameLine();
     if (ImGui::Button("load clips")) changed = true;
   }
+  row("animation");
   int mode = static_cast<int>(session_->params().mode);
-  if (ImGui::Combo("mode", &mode, kModes, 3)) {
+  if (ImGui::Combo("##mode", &mode, kModes, 3)) {
     MediatorParams p = session_->params();
     p.mode = static_cast<MediatorMode>(mode);
     session_->set_params(p);
@@ -79,35 +118,64 @@ void DemoApp::panel_crowd() {
   help_marker(
       "naive: nearest clip at its native rate (skating); rate: speed-matched playback "
       "only; apm: the whole mediator");
-  if (changed) {
-    crowd_.sim = sim_kind_ == 1 ? "detour" : "social";
-    if (sim_kind_ == 2) {
-      crowd_.scenario = replay_path_;
-      crowd_.agents.clear();
-    } else {
-      if (ends_with(crowd_.scenario, ".txt")) crowd_.scenario = "crossing";
-      crowd_.agents = std::to_string(std::max(agents_, 0));
-    }
-    crowd_.clips.clear();
-    if (!builtin_clips_) crowd_.clips.push_back(clip_path_);
-    // Keep the current parameters (and mode) across the rebuild.
-    crowd_.sets.clear();
-    crowd_.params_file.clear();
-    crowd_.mode = std::string(mediator_mode_name(session_->params().mode));
-    const MediatorParams keep = session_->params();
-    if (rebuild()) session_->set_params(keep);
-  }
+  if (changed) apply_crowd();
   ImGui::Text("%s, %zu live agents, t = %.1f s", session_->crowd().name().c_str(),
               session_->frame().size(), session_->crowd().time_s());
 }
 
+void DemoApp::apply_crowd() {
+  crowd_.sim = sim_kind_ == 1 ? "detour" : "social";
+  if (sim_kind_ == 2) {
+    crowd_.scenario = replay_path_;
+    crowd_.agents.clear();
+  } else {
+    if (ends_with(crowd_.scenario, ".txt")) crowd_.scenario = "crossing";
+    crowd_.agents = agents_edited_ ? std::to_string(std::max(agents_, 0)) : "";
+  }
+  crowd_.clips.clear();
+  if (!builtin_clips_) crowd_.clips.push_back(clip_path_);
+  // Keep the current parameters (and mode) across the rebuild.
+  crowd_.sets.clear();
+  crowd_.params_file.clear();
+  crowd_.mode = std::string(mediator_mode_name(session_->params().mode));
+  const MediatorParams keep = session_->params();
+  if (rebuild()) session_->set_params(keep);
+}
+
+void DemoApp::panel_clips() {
+  const auto& clips = session_->library().clips;
+  ImGui::Text("%zu clips (speed and direction from clip analysis)", clips.size());
+  if (!ImGui::BeginTable("clips", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY,
+                         ImVec2(0.0f, 160.0f))) {
+    return;
+  }
+  ImGui::TableSetupColumn("clip");
+  ImGui::TableSetupColumn("m/s", ImGuiTableColumnFlags_WidthFixed, 44.0f);
+  ImGui::TableSetupColumn("dir", ImGuiTableColumnFlags_WidthFixed, 40.0f);
+  ImGui::TableSetupColumn("cycle s", ImGuiTableColumnFlags_WidthFixed, 52.0f);
+  ImGui::TableHeadersRow();
+  for (const LocomotionClip& c : clips) {
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn();
+    ImGui::TextUnformatted(c.clip.name.c_str());
+    ImGui::TableNextColumn();
+    ImGui::Text("%.2f", c.speed_m_s);
+    ImGui::TableNextColumn();
+    ImGui::Text("%.0f", c.direction_rad * 57.29578f);
+    ImGui::TableNextColumn();
+    ImGui::Text("%.2f", c.cycle_s);
+  }
+  ImGui::EndTable();
+}
+
 void DemoApp::panel_view() {
-  ImGui::Checkbox("pause", &paused_);
+  if (ImGui::Checkbox("pause", &paused_)) clock_.reset();
   ImGui::SameLine();
-  if (ImGui::Button("step")) step_once_ = true, paused_ = true;
+  if (ImGui::Button("step")) step_requested_ = true, paused_ = true;
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(140.0f);
-  ImGui::SliderFloat("time scale", &time_scale_, 0.05f, 2.0f, "%.2fx");
+  if (ImGui::Button("restart")) restart_requested_ = true;
+  row("time scale");
+  ImGui::SliderFloat("##time_scale", &time_scale_, 0.05f, 2.0f, "%.2fx");
   if (ImGui::Checkbox("compare naive | apm", &compare_)) {
     if (compare_) {
       session_->enable_compare(MediatorMode::kNaive);
@@ -128,6 +196,12 @@ void DemoApp::panel_view() {
   ImGui::SameLine();
   ImGui::Checkbox("facing", &overlays_.facing);
   help_marker("Lower body (pelvis, blue) and upper body (chest, orange) facing");
+  ImGui::SameLine();
+  ImGui::Checkbox("torso fan", &overlays_.torso);
+  help_marker(
+      "Selected agent: pelvis (blue), chest (orange) and theta (yellow) directions, the twist "
+      "filled between pelvis and chest, the torsion limit as a white arc, the twist above the "
+      "head");
   ImGui::Checkbox("planted feet", &overlays_.planted);
   help_marker("White crosses: feet locked in world space by two-bone IK");
   ImGui::SameLine();
@@ -142,6 +216,19 @@ void DemoApp::panel_view() {
 }
 
 void DemoApp::panel_metrics() {
+  const bool behind = clock_.behind() && !paused_;
+  if (fps_ > 0.0f) {
+    ImGui::Text("%.0f FPS", fps_);
+  } else {
+    ImGui::TextDisabled("FPS after 0.5 s");
+  }
+  ImGui::SameLine();
+  if (behind) {
+    ImGui::TextColored(ImVec4(1.0f, 0.65f, 0.25f, 1.0f), "simulation at %.2fx real time",
+                       clock_.achieved_rate());
+  } else {
+    ImGui::TextDisabled("simulation %s", paused_ ? "paused" : "keeps real time");
+  }
   const int n = metrics_.count();
   for (int s = 0; s < kNumLiveSeries; ++s) {
     const auto series = static_cast<LiveSeries>(s);
@@ -178,14 +265,21 @@ void DemoApp::panel_agent() {
     if (frame.ids[i] == selected_id_) index = static_cast<int>(i);
   }
   if (index < 0) {
-    ImGui::Text("agent %lld has left", static_cast<long long>(selected_id_));
+    ImGui::Text("agent %lld is not in the scene", static_cast<long long>(selected_id_));
     return;
   }
   const AnimationPlans& plans = session_->mediator().plans();
   const int slot = plans.slot_of_agent[index];
   ImGui::Text("agent %lld  speed %.2f m/s  %s", static_cast<long long>(selected_id_),
               plans.speed_m_s[slot], plans.standing[slot] ? "(standing)" : "");
-  ImGui::Checkbox("follow", &follow_);
+  bool follow = director_.following();
+  if (ImGui::Checkbox("follow", &follow)) {
+    if (follow) {
+      director_.follow(selected_id_);
+    } else {
+      director_.stop_following();
+    }
+  }
   ImGui::Text("phase %.2f  playback rate %.2fx  blend %.2f", plans.phase[slot],
               plans.playback_rate[slot], plans.blend_progress[slot]);
   ImGui::Text("torsion %.1f deg", session_->poses().torsion(slot) * 57.29578f);
@@ -210,20 +304,22 @@ void DemoApp::panel_params() {
   bool changed = false;
   for (const ParamInfo& info : mediator_param_infos()) {
     ImGui::PushID(info.name);
+    row(param_label(info.name));
+    const bool label_hovered = ImGui::IsItemHovered();
     if (info.kind == ParamInfo::Kind::kBool) {
-      changed |= ImGui::Checkbox(info.name, &(p.*info.b));
+      changed |= ImGui::Checkbox("##value", &(p.*info.b));
     } else {
       char format[48];
       std::snprintf(format, sizeof(format), "%%.3f %s", info.unit);
-      changed |= ImGui::SliderFloat(info.name, &(p.*info.f), info.min_value, info.max_value, format,
-                                    ImGuiSliderFlags_AlwaysClamp);
+      changed |= ImGui::SliderFloat("##value", &(p.*info.f), info.min_value, info.max_value,
+                                    format, ImGuiSliderFlags_AlwaysClamp);
     }
-    if (ImGui::IsItemHovered()) {
+    if (label_hovered || ImGui::IsItemHovered()) {
       if (info.kind == ParamInfo::Kind::kBool) {
-        ImGui::SetTooltip("%s", info.help);
+        ImGui::SetTooltip("%s\n%s (on/off)", info.help, info.name);
       } else {
-        ImGui::SetTooltip("%s\n[%s], limits %g..%g", info.help, info.unit, info.min_value,
-                          info.max_value);
+        ImGui::SetTooltip("%s\n%s [%s], limits %g..%g", info.help, info.name, info.unit,
+                          info.min_value, info.max_value);
       }
     }
     ImGui::PopID();
@@ -236,7 +332,48 @@ void DemoApp::panel_params() {
     p.seed = seed;
     changed = true;
   }
+  ImGui::SameLine();
+  if (ImGui::Button("save...")) {
+    browser_.open("Save parameters", params_path_, {".json"}, FileBrowser::Mode::kSave, false,
+                  kBrowseSaveParams);
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("load...")) {
+    browser_.open("Load parameters", params_path_, {".json"}, FileBrowser::Mode::kOpen, false,
+                  kBrowseLoadParams);
+  }
+  if (!note_.empty()) ImGui::TextWrapped("%s", note_.c_str());
   if (changed && validate_mediator_params(p).ok()) session_->set_params(p);
+}
+
+void DemoApp::handle_browser() {
+  if (!browser_.draw()) return;
+  const std::string& path = browser_.chosen();
+  switch (browser_.tag()) {
+    case kBrowseClips:
+      clip_path_ = path;
+      apply_crowd();
+      break;
+    case kBrowseTrajectory:
+      replay_path_ = path;
+      apply_crowd();
+      break;
+    case kBrowseSaveParams: {
+      params_path_ = path;
+      std::ofstream out(path);
+      out << mediator_params_to_json(session_->params());
+      note_ = out ? "saved " + path : path + ": cannot write the file";
+      break;
+    }
+    case kBrowseLoadParams: {
+      params_path_ = path;
+      MediatorParams p = session_->params();
+      const Status s = load_mediator_params_json(path, &p);
+      if (s.ok()) session_->set_params(p);
+      note_ = s.ok() ? "loaded " + path : s.message();
+      break;
+    }
+  }
 }
 
 }  // namespace gk::app

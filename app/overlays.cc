@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 namespace gk::app {
 namespace {
@@ -24,12 +25,104 @@ void cross(CrowdRenderer* r, glm::vec3 p, float half, glm::vec3 color) {
   r->add_line(p - glm::vec3(half, 0, -half), p + glm::vec3(half, 0, -half), color);
 }
 
+// Shortest signed angle from heading a to heading b [rad].
+float angle_to(float a, float b) { return std::remainder(b - a, 6.2831853f); }
+
+// A ray drawn as a cross of a flat and an upright ribbon, so it reads as a thick line from any
+// camera pitch (GL core lines are one pixel wide).
+void ribbon(CrowdRenderer* r, glm::vec3 from, glm::vec3 dir, float length, float half_width,
+            glm::vec3 color) {
+  const glm::vec3 tip = from + dir * length;
+  const glm::vec3 side = glm::normalize(glm::cross(dir, glm::vec3(0, 1, 0))) * half_width;
+  const glm::vec3 up(0.0f, half_width, 0.0f);
+  const glm::vec4 c(color, 1.0f);
+  r->add_triangle(from - side, tip - side, tip + side, c);
+  r->add_triangle(from - side, tip + side, from + side, c);
+  r->add_triangle(from - up, tip - up, tip + up, c);
+  r->add_triangle(from - up, tip + up, from + up, c);
+}
+
+// A filled sector between headings a and a + sweep [rad], radii r0..r1 about centre.
+void sector(CrowdRenderer* r, glm::vec3 centre, float a, float sweep, float r0, float r1,
+            glm::vec4 color) {
+  const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(sweep) / 0.05f)));
+  for (int k = 0; k < steps; ++k) {
+    const glm::vec3 d0 = heading_dir(a + sweep * k / steps);
+    const glm::vec3 d1 = heading_dir(a + sweep * (k + 1) / steps);
+    if (r0 <= 0.0f) {
+      r->add_triangle(centre, centre + d0 * r1, centre + d1 * r1, color);
+    } else {
+      r->add_triangle(centre + d0 * r0, centre + d0 * r1, centre + d1 * r1, color);
+      r->add_triangle(centre + d0 * r0, centre + d1 * r1, centre + d1 * r0, color);
+    }
+  }
+}
+
+// The torso fan of one agent: what the simulator asks (theta), what the chest and the pelvis do,
+// the twist between them, and how far the twist may go.
+void torso_fan(CrowdRenderer* r, glm::vec3 ground, float pelvis, float chest, float theta,
+               float limit_rad) {
+  constexpr float kHeight_m = 1.2f;  // about the lowest ribs: the fan stays clear of the arms
+  constexpr float kRadius_m = 0.85f;
+  constexpr glm::vec3 kPelvis(0.25f, 0.55f, 1.0f), kChest(1.0f, 0.5f, 0.1f),
+      kTheta(1.0f, 0.85f, 0.1f);
+  const glm::vec3 c = ground + glm::vec3(0.0f, kHeight_m, 0.0f);
+  const float twist = angle_to(pelvis, chest);
+  const float asked = angle_to(chest, theta);
+  sector(r, c, pelvis, twist, 0.0f, kRadius_m, glm::vec4(kChest, 0.45f));
+  // Theta the chest does not (yet, or may not) follow.
+  sector(r, c, chest, asked, 0.0f, kRadius_m * 1.15f, glm::vec4(kTheta, 0.22f));
+  sector(r, c, pelvis - limit_rad, 2.0f * limit_rad, kRadius_m * 1.22f, kRadius_m * 1.3f,
+         glm::vec4(1.0f, 1.0f, 1.0f, 0.8f));
+  for (const float end : {pelvis - limit_rad, pelvis + limit_rad}) {
+    ribbon(r, c + heading_dir(end) * kRadius_m * 1.12f, heading_dir(end), kRadius_m * 0.28f,
+           0.012f, {1.0f, 1.0f, 1.0f});
+  }
+  ribbon(r, c, heading_dir(pelvis), kRadius_m, 0.02f, kPelvis);
+  ribbon(r, c, heading_dir(chest), kRadius_m, 0.02f, kChest);
+  ribbon(r, c, heading_dir(theta), kRadius_m * 1.15f, 0.015f, kTheta);
+}
+
 glm::vec3 slide_color(float slide_m_s) {
   const float t = std::clamp(slide_m_s / kSkateSpeed_m_s, 0.0f, 1.0f);
   return glm::mix(glm::vec3(0.2f, 0.95f, 0.3f), glm::vec3(1.0f, 0.15f, 0.1f), t);
 }
 
 }  // namespace
+
+bool enable_overlay(const std::string& n, OverlayToggles* t) {
+  if (n == "all") {
+    *t = {true, true, true, true, true, true, true};
+    return true;
+  }
+  bool* flags[] = {&t->velocity, &t->theta, &t->facing, &t->planted,
+                   &t->trails,   &t->paths, &t->torso};
+  const char* names[] = {"velocity", "theta", "facing", "planted", "trails", "paths", "torso"};
+  for (int k = 0; k < 7; ++k) {
+    if (n == names[k]) return *flags[k] = true;
+  }
+  return false;
+}
+
+std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
+                                          int64_t agent_id) {
+  const AgentFrame& frame = session.frame();
+  const AnimationPlans& plans = lane.mediator->plans();
+  for (size_t i = 0; i < frame.size(); ++i) {
+    if (frame.ids[i] != agent_id) continue;
+    const int slot = plans.slot_of_agent[i];
+    if (slot < 0) return std::nullopt;
+    const glm::vec2 root = plans.root_xz[slot];
+    const float pelvis = lane.poses->pelvis_heading(slot);
+    TorsoReadout out;
+    out.head = glm::vec3(root.x, 2.05f, root.y);
+    out.twist_deg = glm::degrees(angle_to(pelvis, lane.poses->upper_heading(slot)));
+    out.theta_deg = glm::degrees(angle_to(pelvis, frame.thetas[i]));
+    out.limit_deg = session.params().torsion_limit_deg;
+    return out;
+  }
+  return std::nullopt;
+}
 
 OverlayHistory::OverlayHistory(const CrowdSession& session, size_t capacity)
     : capacity_(std::max<size_t>(capacity, 1)) {
@@ -155,6 +248,11 @@ void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane
       }
     }
     if (selected_id >= 0 && frame.ids[i] == selected_id) {
+      if (t.torso) {
+        const int s = static_cast<int>(slot);
+        torso_fan(r, ground, poses.pelvis_heading(s), poses.upper_heading(s), frame.thetas[i],
+                  glm::radians(session.params().torsion_limit_deg));
+      }
       constexpr int kSegments = 24;
       for (int k = 0; k < kSegments; ++k) {
         const float a0 = 6.2831853f * k / kSegments, a1 = 6.2831853f * (k + 1) / kSegments;

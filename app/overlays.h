@@ -5,7 +5,10 @@
 // Histories are ring buffers per mediator slot sized at creation: recording allocates nothing.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
+
+#include <string>
 
 #include <glm/vec3.hpp>
 
@@ -22,8 +25,27 @@ struct OverlayToggles {
   bool trails = false;  // support-foot toe within 5 cm of its floor (METRICS.md v2), green (still)
                         // .. red (>= 30 cm/s)
   bool paths = false;   // root path of the last 4 s (violet)
-  bool any() const { return velocity || theta || facing || planted || trails || paths; }
+  // The selected agent's torso fan: pelvis (blue), chest (orange) and theta (yellow) directions,
+  // the twist filled between pelvis and chest, and the torsion limit as a white arc.
+  bool torso = false;
+  bool any() const { return velocity || theta || facing || planted || trails || paths || torso; }
 };
+
+// Overlay names of the CLI (`--overlay`): velocity, theta, facing, planted, trails, paths, torso
+// and all. Sets the toggle and returns true, or false for an unknown name.
+bool enable_overlay(const std::string& name, OverlayToggles* toggles);
+inline constexpr const char* kOverlayNames =
+    "velocity, theta, facing, planted, trails, paths, torso or all";
+
+// What the torso fan shows, for its label above the head.
+struct TorsoReadout {
+  glm::vec3 head{0.0f};     // a point just above the head [m]
+  float twist_deg = 0.0f;   // chest heading - pelvis heading, signed
+  float theta_deg = 0.0f;   // simulator's theta - pelvis heading, signed (what was asked)
+  float limit_deg = 0.0f;   // the torsion limit
+};
+std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
+                                          int64_t agent_id);
 
 // Slide speed [m/s] from which a trail sample is fully red: METRICS.md's skate threshold.
 inline constexpr float kSkateSpeed_m_s = 0.30f;
@@ -38,7 +60,8 @@ class OverlayHistory {
   // samples above kSkateSpeed_m_s.
   float last_slide_m_s() const { return last_slide_m_s_; }
   float last_skate_ratio() const { return last_skate_ratio_; }
-  // Queues the enabled overlays as debug lines. `selected_id` (or -1) gets a ring at its feet.
+  // Queues the enabled overlays as debug lines (and the torso fan's triangles). `selected_id` (or
+  // -1) gets a ring at its feet and, with `torso`, the fan.
   void draw(const CrowdSession& session, const AnimationLane& lane, const OverlayToggles& toggles,
             int64_t selected_id, CrowdRenderer* renderer) const;
 

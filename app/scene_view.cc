@@ -27,6 +27,58 @@ OrbitCamera frame_bounds(glm::vec2 lo, glm::vec2 hi, glm::ivec2 viewport_px) {
   return c;
 }
 
+Exhibits make_exhibits(const CrowdSetup& setup, glm::vec2 scene_center, float wall_thickness_m) {
+  constexpr glm::vec3 kBoard(0.85f, 0.95f, 0.05f);   // half size [m]: 1.7 m wide, 1.9 m tall
+  constexpr glm::vec3 kCanvas(0.68f, 0.45f, 0.02f);  // half size [m]
+  constexpr float kCanvasHeight_m = 1.3f;            // eye level of the people looking at it
+  constexpr glm::vec3 kBoardColor(0.10f, 0.07f, 0.05f);
+  Exhibits out;
+  for (const AttentionTarget& t : setup.attention_targets) {
+    // The nearest wall within 1 m holds the board; its normal points from the wall to the target.
+    float best = 1.0f;
+    glm::vec2 normal = scene_center - t.position, base = t.position;
+    for (const WallSegment& w : setup.walls) {
+      const glm::vec2 d = w.b - w.a;
+      const float len2 = glm::dot(d, d);
+      const float u = len2 > 1e-9f ? std::clamp(glm::dot(t.position - w.a, d) / len2, 0.0f, 1.0f)
+                                   : 0.0f;
+      const glm::vec2 q = w.a + u * d;
+      const float dist = glm::length(t.position - q);
+      if (dist < best && dist > 1e-4f) {
+        best = dist;
+        normal = t.position - q;
+        base = q + glm::normalize(normal) * (0.5f * wall_thickness_m + kBoard.z);
+      }
+    }
+    if (glm::length(normal) < 1e-4f) normal = glm::vec2(0.0f, 1.0f);
+    normal = glm::normalize(normal);
+    const float yaw = std::atan2(normal.x, normal.y);
+    PropBox board;
+    board.center = glm::vec3(base.x, kBoard.y, base.y);
+    board.half_size = kBoard;
+    board.yaw_rad = yaw;
+    board.color = kBoardColor;
+    PropBox canvas = board;
+    const glm::vec2 front = base + normal * (kBoard.z + kCanvas.z);
+    canvas.center = glm::vec3(front.x, kCanvasHeight_m, front.y);
+    canvas.half_size = kCanvas;
+    canvas.color = kExhibitCanvasColor;
+    out.boxes.push_back(board);
+    out.boxes.push_back(canvas);
+    out.canvas_centers.push_back(canvas.center + glm::vec3(normal.x, 0.0f, normal.y) * kCanvas.z);
+  }
+  return out;
+}
+
+std::optional<FollowedAgent> followed_agent(const CrowdSession& session, int64_t id) {
+  const AgentFrame& frame = session.frame();
+  const auto draws = session.lane().draw_span();
+  for (size_t i = 0; i < draws.size() && i < frame.size(); ++i) {
+    if (frame.ids[i] == id) return FollowedAgent{draws[i].position, frame.velocities[i]};
+  }
+  return std::nullopt;
+}
+
 Result<std::unique_ptr<SceneView>> SceneView::create(const CrowdSession& session) {
   auto view = std::unique_ptr<SceneView>(new SceneView());
   view->renderer_ = std::make_unique<CrowdRenderer>();
@@ -34,6 +86,10 @@ Result<std::unique_ptr<SceneView>> SceneView::create(const CrowdSession& session
   auto mesh = view->renderer_->add_mesh(session.mesh());
   if (!mesh.ok()) return Status::Error("mesh: " + mesh.message());
   GK_RETURN_IF_ERROR(view->renderer_->set_walls(session.wall_segments()));
+  const glm::vec2 center = 0.5f * (session.bounds_min() + session.bounds_max());
+  const Exhibits exhibits = make_exhibits(session.setup(), center,
+                                          view->renderer_->settings().wall_thickness_m);
+  GK_RETURN_IF_ERROR(view->renderer_->set_props(exhibits.boxes));
   return view;
 }
 

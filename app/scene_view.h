@@ -4,9 +4,12 @@
 // Needs a current GL context for every call, including destruction.
 
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include <glm/vec2.hpp>
 
+#include "app/camera_director.h"
 #include "app/crowd_session.h"
 #include "common/status.h"
 #include "render/camera.h"
@@ -16,6 +19,19 @@ namespace gk::app {
 
 // A 3/4 view (yaw 35 deg, pitch 40 deg) that fits the ground box [lo, hi] into the viewport.
 OrbitCamera frame_bounds(glm::vec2 lo, glm::vec2 hi, glm::ivec2 viewport_px);
+
+// The scenario's attention targets drawn as exhibits: a dark display board standing against the
+// nearest wall (or free, facing the scene's centre) with a teal canvas on its front.
+struct Exhibits {
+  std::vector<PropBox> boxes;
+  std::vector<glm::vec3> canvas_centers;  // [m], for reports and tests
+};
+inline constexpr glm::vec3 kExhibitCanvasColor{0.02f, 0.42f, 0.48f};  // linear RGB
+Exhibits make_exhibits(const CrowdSetup& setup, glm::vec2 scene_center, float wall_thickness_m);
+
+// The agent `id` as drawn by the primary lane (after collect()) with its simulator velocity, or
+// nullopt when it is not in the frame.
+std::optional<FollowedAgent> followed_agent(const CrowdSession& session, int64_t id);
 
 class SceneView {
  public:

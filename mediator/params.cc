@@ -1,5 +1,6 @@
 #include "mediator/params.h"
 
+#include <charconv>
 #include <cmath>
 #include <sstream>
 
@@ -206,6 +207,24 @@ Status validate_mediator_params(const MediatorParams& p) {
     return Status::Error("min_playback_rate must not exceed max_playback_rate");
   }
   return Status::Ok();
+}
+
+std::string mediator_params_to_json(const MediatorParams& params) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (const ParamInfo& info : kInfos) {
+    if (info.kind == K::kBool) {
+      j[info.name] = params.*info.b;
+      continue;
+    }
+    // Shortest decimal of the float ("0.05", not 0.05000000074505806); as a double it still
+    // rounds back to the same float (double has more than twice float's precision).
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof(text), params.*info.f).ptr;
+    j[info.name] = std::stod(std::string(text, end));
+  }
+  j["mode"] = std::string(mediator_mode_name(params.mode));
+  j["seed"] = params.seed;
+  return j.dump(2) + "\n";
 }
 
 }  // namespace gk

@@ -71,5 +71,9 @@ Status load_mediator_params_json(const std::string& path, MediatorParams* params
 Status parse_mediator_params_json(std::string_view json_text, const std::string& source_name,
                                   MediatorParams* params);
 Status validate_mediator_params(const MediatorParams& params);
+// The parameters as a JSON object (every parameter of the table in its order, then "mode" and
+// "seed") that parse_mediator_params_json reads back to the same values; a float is written as
+// the shortest decimal that reads back to it.
+std::string mediator_params_to_json(const MediatorParams& params);
 
 }  // namespace gk

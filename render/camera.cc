@@ -74,6 +74,18 @@ void OrbitCamera::zoom(float factor) {
   distance_m = std::clamp(distance_m * factor, near_m * 2.0f, far_m * 0.5f);
 }
 
+void OrbitCamera::zoom_about(glm::vec2 pixel, glm::ivec2 viewport_px, float factor) {
+  if (!(factor > 0.0f)) return;
+  const std::optional<glm::vec3> hit = intersect_ground(pick_ray(pixel, viewport_px));
+  const float before = distance_m;
+  zoom(factor);
+  if (!hit) return;
+  // Scaling the whole camera (eye and target) about the hit point keeps the view direction, so
+  // the hit projects to the same pixel; the clamped factor is the one that was applied.
+  const float applied = distance_m / before;
+  target = *hit + (target - *hit) * applied;
+}
+
 std::optional<glm::vec3> intersect_ground(const Ray& ray, float height_m) {
   if (std::abs(ray.direction.y) < 1e-6f) return std::nullopt;
   const float t = (height_m - ray.origin.y) / ray.direction.y;

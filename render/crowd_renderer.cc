@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <string>
+#include <utility>
 
 namespace gk {
 namespace {
@@ -27,19 +28,19 @@ void CrowdRenderer::release() {
   }
   meshes_.clear();
   if (!initialized_) return;
-  const GLuint buffers[] = {frame_ubo_, palette_buffer_, instance_buffer_, wall_buffer_,
-                            line_buffer_};
-  glDeleteBuffers(5, buffers);
+  const GLuint buffers[] = {frame_ubo_,  palette_buffer_, instance_buffer_, wall_buffer_,
+                            prop_buffer_, line_buffer_,    triangle_buffer_};
+  glDeleteBuffers(7, buffers);
   glDeleteTextures(1, &palette_texture_);
-  const GLuint vaos[] = {empty_vao_, shadow_vao_, wall_vao_, line_vao_};
-  glDeleteVertexArrays(4, vaos);
+  const GLuint vaos[] = {empty_vao_, shadow_vao_, wall_vao_, prop_vao_, line_vao_, triangle_vao_};
+  glDeleteVertexArrays(6, vaos);
   initialized_ = false;
 }
 
 Status CrowdRenderer::init(const RendererConfig& config) {
   if (initialized_) return Status::Error("CrowdRenderer::init: already initialised");
   if (config.initial_agent_capacity < 1 || config.initial_joints_per_agent < 1 ||
-      config.max_debug_lines < 0) {
+      config.max_debug_lines < 0 || config.max_debug_triangles < 0) {
     return Status::Error("CrowdRenderer::init: capacities must be positive");
   }
   config_ = config;
@@ -71,11 +72,15 @@ Status CrowdRenderer::init(const RendererConfig& config) {
   glGenTextures(1, &palette_texture_);
   glGenBuffers(1, &instance_buffer_);
   glGenBuffers(1, &wall_buffer_);
+  glGenBuffers(1, &prop_buffer_);
   glGenBuffers(1, &line_buffer_);
+  glGenBuffers(1, &triangle_buffer_);
   glGenVertexArrays(1, &empty_vao_);
   glGenVertexArrays(1, &shadow_vao_);
   glGenVertexArrays(1, &wall_vao_);
+  glGenVertexArrays(1, &prop_vao_);
   glGenVertexArrays(1, &line_vao_);
+  glGenVertexArrays(1, &triangle_vao_);
   glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texture_buffer_texels_);
 
   palette_capacity_matrices_ =
@@ -99,21 +104,28 @@ Status CrowdRenderer::init(const RendererConfig& config) {
                         reinterpret_cast<void*>(offsetof(GpuInstance, ground)));
   glVertexAttribDivisor(7, 1);
 
-  glBindVertexArray(line_vao_);
-  glBindBuffer(GL_ARRAY_BUFFER, line_buffer_);
-  glBufferData(GL_ARRAY_BUFFER, std::max(config.max_debug_lines, 1) * 2 * sizeof(LineVertex),
-               nullptr, GL_STREAM_DRAW);
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex), nullptr);
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex),
-                        reinterpret_cast<void*>(offsetof(LineVertex, color)));
+  // Lines and translucent triangles share the vertex layout and the program.
+  const std::pair<GLuint, GLuint> batches[] = {{line_vao_, line_buffer_},
+                                               {triangle_vao_, triangle_buffer_}};
+  const size_t batch_vertices[] = {static_cast<size_t>(std::max(config.max_debug_lines, 1)) * 2,
+                                   static_cast<size_t>(std::max(config.max_debug_triangles, 1)) * 3};
+  for (int k = 0; k < 2; ++k) {
+    glBindVertexArray(batches[k].first);
+    glBindBuffer(GL_ARRAY_BUFFER, batches[k].second);
+    glBufferData(GL_ARRAY_BUFFER, batch_vertices[k] * sizeof(LineVertex), nullptr, GL_STREAM_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, sizeof(LineVertex),
+                          reinterpret_cast<void*>(offsetof(LineVertex, color)));
+  }
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 
   instances_.resize(instance_capacity_);
   visible_.resize(instance_capacity_);
   lines_.reserve(static_cast<size_t>(config.max_debug_lines) * 2);
+  triangles_.reserve(static_cast<size_t>(config.max_debug_triangles) * 3);
   if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
     return Status::Error("CrowdRenderer::init: GL error " + std::to_string(error));
   }
@@ -252,10 +264,16 @@ Status CrowdRenderer::draw_region(const OrbitCamera& camera, glm::ivec2 origin_p
   if (settings_.draw_walls) draw_walls();
   draw_agents();
   if (settings_.draw_shadows && num_visible > 0) draw_shadows(num_visible);
-  if (settings_.draw_lines) draw_lines();
+  if (settings_.draw_lines) {
+    draw_triangles();
+    draw_lines();
+  }
   stats_.lines_dropped = dropped_lines_;
+  stats_.triangles_dropped = dropped_triangles_;
   lines_.clear();
+  triangles_.clear();
   dropped_lines_ = 0;
+  dropped_triangles_ = 0;
   glDisable(GL_SCISSOR_TEST);
   glBindVertexArray(0);
   glUseProgram(0);

@@ -33,6 +33,14 @@ struct AgentDraw {
   int mesh = 0;              // id returned by add_mesh
 };
 
+// An upright box standing on or above the ground (exhibits, props): lit like the walls.
+struct PropBox {
+  glm::vec3 center{0.0f};       // [m]
+  glm::vec3 half_size{0.5f};    // [m] along its local x (width), y (up), z (depth) [Limit: > 0]
+  float yaw_rad = 0.0f;         // heading of its local +z about +y (+z -> (sin, 0, cos))
+  glm::vec3 color{1.0f};        // linear RGB
+};
+
 // Look of the scene; colours are linear RGB unless noted. Safe to change between frames.
 struct RenderSettings {
   glm::vec3 sun_direction{0.45f, 0.8f, 0.4f};  // toward the sun (normalised on use)
@@ -70,12 +78,15 @@ struct RenderStats {
   int agents_culled = 0;
   int lines_drawn = 0;
   int lines_dropped = 0;  // add_line calls beyond max_debug_lines, since the last draw
+  int triangles_drawn = 0;
+  int triangles_dropped = 0;  // add_triangle calls beyond max_debug_triangles
 };
 
 struct RendererConfig {
   int initial_agent_capacity = 1024;  // instances before the first growth
   int initial_joints_per_agent = 64;  // palette capacity = agents * joints before growth
   int max_debug_lines = 1 << 16;      // fixed; further add_line calls are dropped and counted
+  int max_debug_triangles = 1 << 14;  // fixed; likewise for add_triangle
 };
 
 class CrowdRenderer {
@@ -101,10 +112,16 @@ class CrowdRenderer {
   // Walls as 2D segments on the ground, (x0, z0, x1, z1) [m] each, drawn as low boxes with the
   // wall_* settings current at this call. Static: call when the scenario changes, not per frame.
   Status set_walls(std::span<const glm::vec4> segments);
+  // Static boxes (exhibits and other props); replaces the previous set. Static like the walls.
+  Status set_props(std::span<const PropBox> boxes);
 
   // Debug line in world space with a display (sRGB) colour; batched and drawn by the next draw()
   // in one call, then cleared.
   void add_line(const glm::vec3& a, const glm::vec3& b, const glm::vec3& color);
+  // Translucent debug triangle (display colour, alpha in w; both sides), batched like the lines
+  // and drawn just before them (fans, wedges). Beyond max_debug_triangles they are dropped.
+  void add_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                    const glm::vec4& color);
 
   // Clears and renders the frame into the bound framebuffer (viewport_px = its size).
   Status draw(const OrbitCamera& camera, glm::ivec2 viewport_px, std::span<const AgentDraw> agents);
@@ -133,9 +150,9 @@ class CrowdRenderer {
     uint32_t palette_base;  // first matrix of this agent in the palette buffer
     glm::vec4 ground;       // xyz: ground point [m], w: shadow radius [m]
   };
-  struct LineVertex {
+  struct LineVertex {  // matches lines.vert; lines have alpha 1
     glm::vec3 position;
-    glm::vec3 color;
+    glm::vec4 color;
   };
 
   int cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport_px,
@@ -143,6 +160,7 @@ class CrowdRenderer {
   void upload_frame_block(const OrbitCamera& camera, glm::ivec2 viewport_px);
   void draw_ground();
   void draw_walls();
+  void draw_triangles();
   void draw_agents();
   void draw_shadows(int num_visible);
   void draw_lines();
@@ -165,15 +183,20 @@ class CrowdRenderer {
   GLuint shadow_vao_ = 0;
   GLuint wall_vao_ = 0, wall_buffer_ = 0;
   GLsizei num_wall_vertices_ = 0;
+  GLuint prop_vao_ = 0, prop_buffer_ = 0;
+  GLsizei num_prop_vertices_ = 0;
   GLuint line_vao_ = 0, line_buffer_ = 0;
+  GLuint triangle_vao_ = 0, triangle_buffer_ = 0;
   std::vector<MeshGpu> meshes_;
   // Per-frame scratch, grown only when a frame brings more agents or lines than ever before.
   std::vector<GpuInstance> instances_;
   std::vector<int> visible_;       // agent indices that survived culling
   std::vector<int> mesh_first_;    // first instance of each mesh in instances_
   std::vector<int> mesh_count_;    // visible instances of each mesh
-  std::vector<LineVertex> lines_;  // reserved to 2 * max_debug_lines at init
+  std::vector<LineVertex> lines_;      // reserved to 2 * max_debug_lines at init
+  std::vector<LineVertex> triangles_;  // reserved to 3 * max_debug_triangles at init
   int dropped_lines_ = 0;
+  int dropped_triangles_ = 0;
 };
 
 }  // namespace gk

@@ -1,5 +1,6 @@
-// The scene around the agents: per-frame uniform block, ground grid, walls, contact shadows and
-// debug lines (CrowdRenderer members kept apart from the skinning path).
+// The scene around the agents: per-frame uniform block, ground grid, walls and props, contact
+// shadows, debug lines and translucent debug triangles (CrowdRenderer members kept apart from the
+// skinning path).
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -36,6 +37,28 @@ void add_quad(std::vector<WallVertex>* out, const glm::vec3& a, const glm::vec3&
               const glm::vec3& c, const glm::vec3& d, const glm::vec3& normal,
               const glm::vec3& color) {
   for (const glm::vec3& p : {a, b, c, a, c, d}) out->push_back({p, normal, color});
+}
+
+// Position, normal and colour attributes of static lit geometry (walls, props) in `vao`.
+void upload_static(GLuint vao, GLuint buffer, const std::vector<WallVertex>& vertices) {
+  glBindVertexArray(vao);
+  glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(WallVertex), vertices.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(WallVertex), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(WallVertex),
+                        reinterpret_cast<void*>(offsetof(WallVertex, normal)));
+  glEnableVertexAttribArray(2);
+  glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, sizeof(WallVertex),
+                        reinterpret_cast<void*>(offsetof(WallVertex, color)));
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+bool finite3(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 }  // namespace
@@ -106,29 +129,56 @@ Status CrowdRenderer::set_walls(std::span<const glm::vec4> segments) {
     }
   }
   num_wall_vertices_ = static_cast<GLsizei>(vertices.size());
-  glBindVertexArray(wall_vao_);
-  glBindBuffer(GL_ARRAY_BUFFER, wall_buffer_);
-  glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(WallVertex), vertices.data(),
-               GL_STATIC_DRAW);
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(WallVertex), nullptr);
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(WallVertex),
-                        reinterpret_cast<void*>(offsetof(WallVertex, normal)));
-  glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, sizeof(WallVertex),
-                        reinterpret_cast<void*>(offsetof(WallVertex, color)));
-  glBindVertexArray(0);
-  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  upload_static(wall_vao_, wall_buffer_, vertices);
+  return Status::Ok();
+}
+
+Status CrowdRenderer::set_props(std::span<const PropBox> boxes) {
+  if (!initialized_) return Status::Error("set_props: renderer not initialised");
+  std::vector<WallVertex> vertices;
+  vertices.reserve(boxes.size() * 36);
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    const PropBox& b = boxes[i];
+    if (!finite3(b.center) || !finite3(b.half_size) || !std::isfinite(b.yaw_rad) ||
+        !finite3(b.color)) {
+      return Status::Error("set_props: box " + std::to_string(i) + " is not finite");
+    }
+    if (!(b.half_size.x > 0.0f && b.half_size.y > 0.0f && b.half_size.z > 0.0f)) {
+      return Status::Error("set_props: box " + std::to_string(i) + " has a size <= 0");
+    }
+    const glm::vec3 ax(std::cos(b.yaw_rad), 0.0f, -std::sin(b.yaw_rad));  // local +x
+    const glm::vec3 az(std::sin(b.yaw_rad), 0.0f, std::cos(b.yaw_rad));   // local +z
+    const glm::vec3 ay(0.0f, 1.0f, 0.0f);
+    const glm::vec3 x = ax * b.half_size.x, y = ay * b.half_size.y, z = az * b.half_size.z;
+    const glm::vec3 c = b.center;
+    // Each face: its centre offset (= its outward normal times the half size) and two in-plane
+    // half axes u, v with u x v along the normal.
+    const glm::vec3 faces[6][3] = {{z, x, y}, {-z, -x, y}, {x, -z, y},
+                                   {-x, z, y}, {y, x, -z}, {-y, x, z}};
+    for (const auto& f : faces) {
+      const glm::vec3 centre = c + f[0];
+      add_quad(&vertices, centre - f[1] - f[2], centre + f[1] - f[2], centre + f[1] + f[2],
+               centre - f[1] + f[2], glm::normalize(f[0]), b.color);
+    }
+  }
+  num_prop_vertices_ = static_cast<GLsizei>(vertices.size());
+  upload_static(prop_vao_, prop_buffer_, vertices);
   return Status::Ok();
 }
 
 void CrowdRenderer::draw_walls() {
-  if (num_wall_vertices_ == 0) return;
+  if (num_wall_vertices_ == 0 && num_prop_vertices_ == 0) return;
   glUseProgram(static_program_.id());
-  glBindVertexArray(wall_vao_);
-  glDrawArrays(GL_TRIANGLES, 0, num_wall_vertices_);
-  ++stats_.draw_calls;
+  if (num_wall_vertices_ > 0) {
+    glBindVertexArray(wall_vao_);
+    glDrawArrays(GL_TRIANGLES, 0, num_wall_vertices_);
+    ++stats_.draw_calls;
+  }
+  if (num_prop_vertices_ > 0) {
+    glBindVertexArray(prop_vao_);
+    glDrawArrays(GL_TRIANGLES, 0, num_prop_vertices_);
+    ++stats_.draw_calls;
+  }
 }
 
 void CrowdRenderer::draw_shadows(int num_visible) {
@@ -152,8 +202,41 @@ void CrowdRenderer::add_line(const glm::vec3& a, const glm::vec3& b, const glm::
     ++dropped_lines_;
     return;
   }
-  lines_.push_back({a, color});
-  lines_.push_back({b, color});
+  const glm::vec4 c(color, 1.0f);
+  lines_.push_back({a, c});
+  lines_.push_back({b, c});
+}
+
+void CrowdRenderer::add_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                                 const glm::vec4& color) {
+  if (triangles_.size() + 3 > static_cast<size_t>(config_.max_debug_triangles) * 3) {
+    ++dropped_triangles_;
+    return;
+  }
+  triangles_.push_back({a, color});
+  triangles_.push_back({b, color});
+  triangles_.push_back({c, color});
+}
+
+void CrowdRenderer::draw_triangles() {
+  if (triangles_.empty()) return;
+  glUseProgram(lines_program_.id());
+  glBindVertexArray(triangle_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, triangle_buffer_);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, triangles_.size() * sizeof(LineVertex), triangles_.data());
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  if (settings_.lines_on_top) glDisable(GL_DEPTH_TEST);
+  // Translucent and seen from both sides; they must not hide each other in the depth buffer. The
+  // frame's alpha stays 1 so captured images are opaque.
+  glDepthMask(GL_FALSE);
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(triangles_.size()));
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+  glEnable(GL_DEPTH_TEST);
+  ++stats_.draw_calls;
+  stats_.triangles_drawn = static_cast<int>(triangles_.size() / 3);
 }
 
 void CrowdRenderer::draw_lines() {

@@ -1,4 +1,4 @@
-in vec3 v_color;
+in vec4 v_color;
 out vec4 frag_color;
 
-void main() { frag_color = vec4(v_color, 1.0); }
+void main() { frag_color = v_color; }

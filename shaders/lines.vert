@@ -1,10 +1,11 @@
-// Debug lines: world-space endpoints with a display colour each.
+// Debug lines and translucent debug triangles: world-space vertices with a display colour and
+// an alpha each.
 
 
 layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_color;
+layout(location = 1) in vec4 a_color;
 
-out vec3 v_color;
+out vec4 v_color;
 
 void main() {
   v_color = a_color;

@@ -57,6 +57,38 @@ TEST(Camera, OrbitPanZoomStayInLimits) {
   EXPECT_NEAR(camera.target.y - before.y, visible, 1e-3f);
 }
 
+TEST(Camera, ZoomAboutKeepsTheGroundPointUnderTheCursor) {
+  OrbitCamera camera;
+  camera.target = {2.0f, 0.9f, -1.0f};
+  camera.yaw_rad = 0.6f;
+  camera.pitch_rad = 0.5f;
+  camera.distance_m = 20.0f;
+  const glm::ivec2 viewport(800, 450);
+  const glm::vec2 cursor(620.0f, 330.0f);  // off centre: a plain zoom would move this point
+  const std::optional<glm::vec3> before = intersect_ground(camera.pick_ray(cursor, viewport));
+  ASSERT_TRUE(before.has_value());
+  OrbitCamera plain = camera;
+  plain.zoom(0.5f);
+  camera.zoom_about(cursor, viewport, 0.5f);
+  EXPECT_NEAR(camera.distance_m, 10.0f, 1e-4f);
+  const glm::vec2 moved = camera.project(*before, viewport).pixel;
+  EXPECT_NEAR(moved.x, cursor.x, 0.05f);
+  EXPECT_NEAR(moved.y, cursor.y, 0.05f);
+  // The plain zoom (toward the target) does move it: the test can tell the two apart.
+  EXPECT_GT(glm::length(plain.project(*before, viewport).pixel - cursor), 50.0f);
+  // Clamped at the near limit, the cursor point still stays put.
+  camera.zoom_about(cursor, viewport, 1e-6f);
+  EXPECT_GE(camera.distance_m, camera.near_m);
+  const glm::vec2 clamped = camera.project(*before, viewport).pixel;
+  EXPECT_NEAR(glm::length(clamped - cursor), 0.0f, 0.5f);
+  // Above the horizon there is no ground point: a plain zoom.
+  OrbitCamera level;
+  level.pitch_rad = 0.0f;
+  level.zoom_about({400.0f, 10.0f}, viewport, 0.5f);
+  EXPECT_NEAR(level.distance_m, OrbitCamera().distance_m * 0.5f, 1e-4f);
+  EXPECT_EQ(level.target, OrbitCamera().target);
+}
+
 TEST(Camera, FrustumKeepsVisibleAndRejectsHiddenSpheres) {
   OrbitCamera camera;
   const Frustum frustum(camera.view_projection({640, 360}));
@@ -223,6 +255,45 @@ TEST_F(RenderApiTest, DebugLinesAndWallsAreDrawn) {
   // Lines last one frame.
   ASSERT_NO_FATAL_FAILURE(render({}, &scene));
   EXPECT_EQ(renderer_->stats().lines_drawn, 0);
+}
+
+TEST_F(RenderApiTest, PropsAndTranslucentTrianglesAreDrawn) {
+  FrameCapture empty, scene;
+  ASSERT_NO_FATAL_FAILURE(render({}, &empty));
+  // A teal panel standing 3 m behind the target, turned 30 deg, and a half-transparent red
+  // triangle on the ground in front of it.
+  PropBox panel;
+  panel.center = {0.0f, 1.0f, -3.0f};
+  panel.half_size = {1.0f, 0.8f, 0.05f};
+  panel.yaw_rad = 0.5f;
+  panel.color = {0.02f, 0.45f, 0.5f};
+  ASSERT_TRUE(renderer_->set_props(std::span(&panel, 1)).ok());
+  renderer_->add_triangle({1.0f, 0.02f, 0.5f}, {3.0f, 0.02f, 0.5f}, {2.0f, 0.02f, 2.0f},
+                          {1.0f, 0.0f, 0.0f, 0.5f});
+  ASSERT_NO_FATAL_FAILURE(render({}, &scene));
+  EXPECT_EQ(renderer_->stats().triangles_drawn, 1);
+  ASSERT_TRUE(scene.save_png(scratch_dir("render") + "/props_triangles.png").ok());
+  const ProjectedPoint on_panel = camera_.project(panel.center, viewport());
+  const glm::u8vec4 p =
+      scene.pixel(static_cast<int>(on_panel.pixel.x), static_cast<int>(on_panel.pixel.y));
+  EXPECT_GT(p.z, p.x + 40) << "teal expected: " << int(p.x) << "," << int(p.y) << "," << int(p.z);
+  EXPECT_GT(p.y, p.x + 40);
+  // Half red over the grey ground: redder than the ground, yet not pure red.
+  const ProjectedPoint on_tri = camera_.project({2.0f, 0.02f, 1.0f}, viewport());
+  const int tx = static_cast<int>(on_tri.pixel.x), ty = static_cast<int>(on_tri.pixel.y);
+  const glm::u8vec4 t = scene.pixel(tx, ty), ground = empty.pixel(tx, ty);
+  EXPECT_GT(t.x, ground.x + 30);
+  EXPECT_LT(t.y, ground.y - 30);
+  EXPECT_GT(t.y, 20) << "the triangle should let the ground show through";
+  EXPECT_EQ(t.w, 255) << "captured frames stay opaque";
+  // Triangles last one frame; bad boxes are refused.
+  ASSERT_NO_FATAL_FAILURE(render({}, &scene));
+  EXPECT_EQ(renderer_->stats().triangles_drawn, 0);
+  panel.half_size.y = 0.0f;
+  EXPECT_FALSE(renderer_->set_props(std::span(&panel, 1)).ok());
+  panel.half_size.y = 1.0f;
+  panel.center.x = std::nanf("");
+  EXPECT_FALSE(renderer_->set_props(std::span(&panel, 1)).ok());
 }
 
 TEST_F(RenderApiTest, DebugLinesBeyondCapacityAreDroppedAndCounted) {

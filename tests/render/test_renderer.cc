@@ -116,7 +116,7 @@ TEST_F(RendererTest, CrowdIsDrawnWhereProjectedAndNowhereElse) {
         std::span(palettes).subspan(i * model.joints_per_agent, model.joints_per_agent)));
   }
   ASSERT_TRUE(renderer_->upload_palettes(palettes, model.joints_per_agent).ok());
-  camera_.distance_m = 14.0f;
+  camera_.distance_m = 20.0f;  // the 30 deg default field of view: the grid fills half the image
   camera_.pitch_rad = 0.45f;
   camera_.target = glm::vec3(0.0f, 0.8f, 0.0f);
 
