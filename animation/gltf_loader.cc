@@ -3,6 +3,8 @@
 
 #include "animation/gltf_loader.h"
 
+#include "animation/bvh_loader.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -412,10 +414,24 @@ Result<ClipSet> clips_from_model(const tinygltf::Model& model, const std::string
                     : internal::load_skinned_mesh(model, mesh_node, bake, build->joint_of_node,
                                                   build->skeleton->num_joints(), path);
   GK_RETURN_IF_ERROR(mesh);
-  if (options.scale_m_per_unit > 0.0f && options.scale_m_per_unit != 1.0f) {
-    apply_scale(options.scale_m_per_unit, build->skeleton.get(), &set.clips, &*mesh);
+  if (options.scale_m_per_unit > 0.0f) {
+    if (options.scale_m_per_unit != 1.0f) {
+      apply_scale(options.scale_m_per_unit, build->skeleton.get(), &set.clips, &*mesh);
+    }
     set.scale_m_per_unit = options.scale_m_per_unit;
     set.scale_reason = "given: " + std::to_string(options.scale_m_per_unit) + " m per unit";
+  } else {
+    // glTF is metres by specification, but exporters write centimetres (or inches) often enough:
+    // the legs are measured, as for BVH, and a file whose legs are 85 units long is scaled.
+    std::string why;
+    const float s = detect_unit_scale(*build->skeleton, &why);
+    if (s != 1.0f) {
+      apply_scale(s, build->skeleton.get(), &set.clips, &*mesh);
+      set.scale_m_per_unit = s;
+      set.scale_reason = why + "; glTF says metres";
+    } else {
+      set.scale_reason = "glTF: metres by specification; " + why;
+    }
   }
   set.mesh = *mesh;
   set.skeleton = build->skeleton;

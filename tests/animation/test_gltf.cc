@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <glm/gtc/quaternion.hpp>
 
 #include "animation/bvh_loader.h"
@@ -286,6 +287,31 @@ TEST(GltfMannequin, AgreesWithTheConvertedBvhClips) {
       }
     }
     EXPECT_LT(worst, 1e-3f) << name;
+  }
+}
+
+// glTF is metres by specification, but a file exported in centimetres is recognised by its size
+// (as BVH files are): the fixture with every node translation times 100 loads at 0.01 m per unit,
+// with the same rest pose in metres as the original.
+TEST(GltfFixture, CentimetreFileIsDetectedFromItsSize) {
+  const std::string good = fixture("good/two_bone_skin.gltf");
+  std::ifstream in(good);
+  nlohmann::json doc = nlohmann::json::parse(in);
+  for (auto& node : doc["nodes"]) {
+    if (!node.contains("translation")) continue;
+    for (auto& x : node["translation"]) x = x.get<double>() * 100.0;
+  }
+  Result<ClipSet> metres = load_gltf(good);
+  Result<ClipSet> cm = parse_gltf(doc.dump(), "cm.gltf");
+  ASSERT_TRUE(metres.ok()) << metres.message();
+  ASSERT_TRUE(cm.ok()) << cm.message();
+  EXPECT_FLOAT_EQ(metres->scale_m_per_unit, 1.0f) << metres->scale_reason;
+  EXPECT_FLOAT_EQ(cm->scale_m_per_unit, 0.01f) << cm->scale_reason;
+  EXPECT_NE(cm->scale_reason.find("centimetres"), std::string::npos) << cm->scale_reason;
+  ASSERT_EQ(cm->skeleton->num_joints(), metres->skeleton->num_joints());
+  for (int j = 0; j < cm->skeleton->num_joints(); ++j) {
+    const glm::vec3 d = cm->skeleton->rest_translations[j] - metres->skeleton->rest_translations[j];
+    EXPECT_LT(glm::length(d), 1e-5f) << cm->skeleton->names[j];
   }
 }
 
