@@ -222,6 +222,43 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
       speed[f] = std::hypot(vel.x, vel.z);
       lc->toe_height_m[s][f] = toe[s][f].y - min_t;
     }
+    // A lock pins the ball: it may start only where the ball itself has come to rest (slower
+    // than half the travel speed, as contact analysis judges a planted point), not while the heel
+    // strikes or the foot rolls off its tip with the ball still moving: each contact's ends are
+    // trimmed to where the ball rests. (Clips authored in place are judged by the direction their
+    // stance foot is carried, not its speed over the ground, which keyframes need not keep.)
+    if (!lc->analysis.in_place) {
+      const float rest = std::max(ContactThresholds{}.min_still_speed_m_s,
+                                  ContactThresholds{}.still_fraction_of_travel * glm::length(travel));
+      std::vector<uint8_t>& pl = lc->plant[s];
+      int first_free = -1;
+      for (int f = 0; f < n && first_free < 0; ++f) {
+        if (!pl[f]) first_free = f;
+      }
+      if (first_free >= 0) {
+        const int span = c.loops ? n : n - first_free;
+        for (int dir : {1, -1}) {
+          bool trimming = false;
+          for (int k = 0; k < span; ++k) {
+            const int f = dir > 0 ? (first_free + k) % n : ((first_free - k) % n + n) % n;
+            if (!c.loops && (f < first_free) == (dir > 0)) continue;
+            if (!pl[f]) {
+              trimming = true;  // a contact begins (or, backward, ends) after this frame
+              continue;
+            }
+            if (trimming && speed[f] > rest) {
+              // Keep the contact's last frame: never trim one away.
+              const int next = dir > 0 ? (f + 1) % n : (f - 1 + n) % n;
+              if (pl[next]) {
+                pl[f] = 0;
+                continue;
+              }
+            }
+            trimming = false;
+          }
+        }
+      }
+    }
     std::vector<float> contact_h, contact_v;
     for (int f = 0; f < n; ++f) {
       if (!lc->plant[s][f]) continue;
