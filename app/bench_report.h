@@ -87,6 +87,9 @@ struct BenchReport {
   uint64_t seed = 1;
   std::optional<int> joints;  // skeleton joint count once poses are synthesised
   std::vector<std::string> clips;
+  // What the library made of takes with root motion: "take: segments; problems" (doubtful
+  // analysis is reported, never silent).
+  std::vector<std::string> takes;
   std::array<std::optional<TimingStat>, kNumStages> timing_ms;
   std::optional<double> us_per_agent;     // median total / agents * 1000
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists

@@ -202,6 +202,7 @@ void run_bench(const BenchOptions& o) {
   report.mode = std::string(mediator_mode_name(params.mode));
   report.joints = library.skeleton->num_joints();
   report.clips = library.clip_names();
+  report.takes = describe_takes(library);
   report.metrics = metrics_to_json(metrics.finish(), library);
   if (dump) {
     if (Status s = dump->close(); !s.ok()) fail(1, s.message());

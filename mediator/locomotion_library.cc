@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <tuple>
 
@@ -389,6 +390,25 @@ float LocomotionClip::time_at_phase(float phase) const {
   const int i = std::min(static_cast<int>(x), kPhaseTableSize - 1);
   const float u = x - i;
   return phase_to_time[i] + u * (phase_to_time[i + 1] - phase_to_time[i]);
+}
+
+std::vector<std::string> describe_takes(const LocomotionLibrary& library) {
+  std::vector<std::string> out;
+  for (const TakeReport& t : library.takes) {
+    std::string line = t.name + ":";
+    char buf[96];
+    for (const TakeSegment& s : t.segmentation.segments) {
+      std::snprintf(buf, sizeof buf, " %s %.2f-%.2f s", segment_kind_name(s.kind), s.span.start_s,
+                    s.span.end_s);
+      line += buf;
+    }
+    line += "; cut into:";
+    if (t.clips.empty()) line += " nothing";
+    for (const std::string& c : t.clips) line += " '" + c + "'";
+    for (const std::string& p : t.segmentation.problems) line += "; " + p;
+    out.push_back(std::move(line));
+  }
+  return out;
 }
 
 std::vector<std::string> LocomotionLibrary::clip_names() const {

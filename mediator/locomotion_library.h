@@ -92,6 +92,9 @@ struct LocomotionLibrary {
   bool has_direction_clips() const { return groups.size() > 1; }
 };
 
+// One line per segmented take: its segments (kind and span), the clips cut from it, and its problems.
+std::vector<std::string> describe_takes(const LocomotionLibrary& library);
+
 // Builds the library from one or more clip sets. The first set's skeleton is the library skeleton;
 // clips of other sets are retargeted to it (retarget_clip). Errors name the set and what is
 // missing.

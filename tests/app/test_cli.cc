@@ -415,5 +415,22 @@ TEST(Cli, AnalyzeClipPlotShadesTheContactsItReports) {
   EXPECT_NE(bad.out.find("--plot"), std::string::npos) << bad.out;
 }
 
+// A take without a steady stride (a jog that stops at once) still gives a library (its least
+// unsteady stride), and bench says so: the report lists the take's segments and the problem, in
+// the text summary and in the JSON report.
+TEST(Cli, BenchReportsWhatItMadeOfEachTake) {
+  const char* clip = "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh";
+  GK_REQUIRE_DATA(clip);
+  const std::string json = test::scratch_dir("cli_takes") + "/report.json";
+  const CommandResult r = run("bench --scenario corridor --agents 6 --frames 30 --clips " +
+                              test::data_path(clip) + " --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("take cmu_16_57_run_jog_sudden_stop_mrl30: stop"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no steady stride"), std::string::npos) << r.out;
+  const nlohmann::json report = read_json(json);
+  ASSERT_EQ(report["takes"].size(), 1u);
+  EXPECT_NE(report["takes"][0].get<std::string>().find("idle"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace gk
