@@ -8,6 +8,8 @@
 #include <numbers>
 #include <tuple>
 
+#include <glm/gtx/quaternion.hpp>
+
 #include "animation/pose_jobs.h"
 #include "animation/segmentation.h"
 #include "common/stats.h"
@@ -479,6 +481,29 @@ Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, f
   }
   for (int j = 0; j < nd; ++j)
     dst_rest_rot[j] = glm::normalize(glm::quat_cast(glm::mat3(dst_rest[j])));
+  // Rest poses need not agree (arms along the body in one, out to the sides in the other): each
+  // mapped bone is first turned, in model space, from its own rest direction onto the source
+  // bone's rest direction (toward the one mapped child both have), so that the source's rest pose
+  // gives the source's shape. A bone without a mapped child (a hand) or with several (the hips)
+  // keeps its parent's turn.
+  std::vector<glm::quat> align(nd, glm::quat(1, 0, 0, 0));
+  for (int j = 0; j < nd; ++j) {
+    const int parent = dst.parents[j];
+    if (parent >= 0) align[j] = align[parent];
+    if (map[j] < 0) continue;
+    int child = -1, mapped_children = 0;
+    for (int c = j + 1; c < nd; ++c) {
+      if (dst.parents[c] == j && map[c] >= 0) {
+        child = c;
+        ++mapped_children;
+      }
+    }
+    if (mapped_children != 1) continue;
+    const glm::vec3 d_dst = translation_of(dst_rest[child]) - translation_of(dst_rest[j]);
+    const glm::vec3 d_src = translation_of(src_rest[map[child]]) - translation_of(src_rest[map[j]]);
+    if (glm::length(d_dst) < 1e-6f || glm::length(d_src) < 1e-6f) continue;
+    align[j] = glm::rotation(glm::normalize(d_dst), glm::normalize(d_src));
+  }
   const int src_hips = src.role(JointRole::kHips), dst_hips = dst.role(JointRole::kHips);
   out.rotations.resize(static_cast<size_t>(out.num_frames) * nd);
   out.translations.resize(out.rotations.size());
@@ -492,7 +517,7 @@ Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, f
       const int s = map[j];
       if (s >= 0) {
         const glm::quat src_rot = glm::normalize(glm::quat_cast(glm::mat3(model[s])));
-        dst_model[j] = glm::normalize(src_rot * src_rest_inv[s] * dst_rest_rot[j]);
+        dst_model[j] = glm::normalize(src_rot * src_rest_inv[s] * align[j] * dst_rest_rot[j]);
       } else {
         dst_model[j] =
             (parent < 0 ? glm::quat(1, 0, 0, 0) : dst_model[parent]) * dst.rest_rotations[j];
