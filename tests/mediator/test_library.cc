@@ -99,5 +99,49 @@ TEST(LocomotionLibrary, MannequinGlbKeepsLocomotionAndItsIdle) {
   ASSERT_TRUE(lib->mesh);  // the glb's own skinned mesh is kept for the renderer
 }
 
+// Retargeting between skeletons whose rest poses differ (the MRL subject-16 skeleton has its arms
+// along the body, the cgspeed one out to the sides): every retargeted bone points where the
+// source bone points, frame by frame, in model space (upper arms, forearms, thighs, shins).
+TEST(LocomotionLibrary, RetargetedBonesPointWhereTheSourceBonesPoint) {
+  const char* mrl = "clips/bvh/more/cmu_16_15_walk_mrl30.bvh";
+  const char* cgspeed = "clips/bvh/more/cmu_16_11_walk_veer_left.bvh";
+  GK_REQUIRE_DATA(mrl);
+  GK_REQUIRE_DATA(cgspeed);
+  Result<ClipSet> src = load_clip_file(test::data_path(mrl));
+  Result<ClipSet> dst = load_clip_file(test::data_path(cgspeed));
+  ASSERT_TRUE(src.ok() && dst.ok());
+  const Skeleton& S = *src->skeleton;
+  const Skeleton& D = *dst->skeleton;
+  const Clip out = retarget_clip(src->clips[0], S, D, 1.0f);
+  struct Bone {
+    const char *src_from, *src_to, *dst_from, *dst_to;
+  };
+  const Bone bones[] = {{"lhumerus", "lradius", "LeftArm", "LeftForeArm"},
+                        {"rhumerus", "rradius", "RightArm", "RightForeArm"},
+                        {"lradius", "lhand", "LeftForeArm", "LeftHand"},
+                        {"lfemur", "ltibia", "LeftUpLeg", "LeftLeg"},
+                        {"rtibia", "rfoot", "RightLeg", "RightFoot"}};
+  std::vector<glm::mat4> ms(S.num_joints()), md(D.num_joints());
+  float worst = 0.0f;
+  for (int f = 0; f < out.num_frames; f += 3) {
+    LocalToModelJob{&S, {src->clips[0].frame_rotations(f), static_cast<size_t>(S.num_joints())},
+                    {src->clips[0].frame_translations(f), static_cast<size_t>(S.num_joints())},
+                    glm::mat4(1.0f), ms}
+        .run();
+    LocalToModelJob{&D, {out.frame_rotations(f), static_cast<size_t>(D.num_joints())},
+                    {out.frame_translations(f), static_cast<size_t>(D.num_joints())},
+                    glm::mat4(1.0f), md}
+        .run();
+    for (const Bone& b : bones) {
+      const glm::vec3 ds = glm::normalize(translation_of(ms[S.find(b.src_to)]) -
+                                          translation_of(ms[S.find(b.src_from)]));
+      const glm::vec3 dd = glm::normalize(translation_of(md[D.find(b.dst_to)]) -
+                                          translation_of(md[D.find(b.dst_from)]));
+      worst = std::max(worst, glm::degrees(std::acos(std::clamp(glm::dot(ds, dd), -1.0f, 1.0f))));
+    }
+  }
+  EXPECT_LT(worst, 5.0f);
+}
+
 }  // namespace
 }  // namespace gk
