@@ -50,12 +50,7 @@ Tracks track_clip_frames(const Clip& clip, const Skeleton& sk) {
     }
   }
   for (int f = 0; f < clip.num_frames; ++f) {
-    LocalToModelJob fk{&sk,
-                       {clip.frame_rotations(f), static_cast<size_t>(clip.num_joints)},
-                       {clip.frame_translations(f), static_cast<size_t>(clip.num_joints)},
-                       glm::mat4(1.0f),
-                       model};
-    fk.run();
+    clip_frame_model(clip, sk, f, model);
     t.root.push_back(translation_of(model[hips]));
     for (int s = 0; s < 2; ++s) {
       const Side side = static_cast<Side>(s);

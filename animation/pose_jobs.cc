@@ -41,6 +41,16 @@ glm::quat rotation_between(glm::vec3 from, glm::vec3 to) {
 
 float heading_of(const glm::vec3& dir) { return std::atan2(dir.x, dir.z); }
 
+void clip_frame_model(const Clip& clip, const Skeleton& skeleton, int frame,
+                      std::span<glm::mat4> out_model) {
+  LocalToModelJob{&skeleton,
+                  {clip.frame_rotations(frame), static_cast<size_t>(clip.num_joints)},
+                  {clip.frame_translations(frame), static_cast<size_t>(clip.num_joints)},
+                  glm::mat4(1.0f),
+                  out_model}
+      .run();
+}
+
 glm::vec3 horizontal_forward(const glm::mat4& m) {
   glm::vec3 f(m[2].x, 0.0f, m[2].z);
   const float len = glm::length(f);

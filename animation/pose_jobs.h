@@ -91,6 +91,9 @@ struct SkinningPaletteJob {
 
 // Small helpers used by several jobs and by analysis.
 inline glm::vec3 translation_of(const glm::mat4& m) { return glm::vec3(m[3]); }
+// Model-space transforms of one frame of a clip (no placement): LocalToModelJob over its rows.
+void clip_frame_model(const Clip& clip, const Skeleton& skeleton, int frame,
+                      std::span<glm::mat4> out_model);
 // Heading [rad] about +y of a horizontal direction (0 = +z, pi/2 = +x).
 float heading_of(const glm::vec3& dir);
 // Forward (+z) direction of a model matrix, projected on the ground and normalised (0 if vertical).

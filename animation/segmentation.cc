@@ -31,12 +31,7 @@ TakeTrack track_take(const Clip& c, const Skeleton& sk) {
   std::vector<glm::mat4> model(sk.num_joints());
   const int hips = std::max(sk.role(JointRole::kHips), 0);
   for (int f = 0; f < c.num_frames; ++f) {
-    LocalToModelJob{&sk,
-                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
-                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
-                    glm::mat4(1.0f),
-                    model}
-        .run();
+    clip_frame_model(c, sk, f, model);
     const glm::vec3 h = translation_of(model[hips]);
     t.hips.emplace_back(h.x, h.z);
     const glm::vec3 lr = translation_of(model[sk.hip(Side::kLeft)]) -

@@ -78,12 +78,7 @@ void draw_clip(Canvas& cv, int top, const ClipPlotInput& in) {
   std::vector<glm::vec3> toe[2];
   std::vector<glm::mat4> model(sk.num_joints());
   for (int f = 0; f < n; ++f) {
-    LocalToModelJob{&sk,
-                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
-                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
-                    glm::mat4(1.0f),
-                    model}
-        .run();
+    clip_frame_model(c, sk, f, model);
     for (int s = 0; s < 2; ++s) {
       glm::vec3 p = translation_of(model[sk.toe(static_cast<Side>(s))]);
       p.y -= a.ground_y0_m + a.ground_slope_m_s * (f / c.fps);

@@ -42,16 +42,6 @@ bool name_excluded(const std::string& name) {
   return false;
 }
 
-// Model-space transforms of one clip frame (no placement).
-void frame_model(const Clip& c, const Skeleton& sk, int f, std::vector<glm::mat4>& model) {
-  LocalToModelJob{&sk,
-                  {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
-                  {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
-                  glm::mat4(1.0f),
-                  model}
-      .run();
-}
-
 std::vector<glm::mat4> rest_model(const Skeleton& sk) {
   std::vector<glm::mat4> m(sk.num_joints());
   LocalToModelJob{&sk, sk.rest_rotations, sk.rest_translations, glm::mat4(1.0f), m}.run();
@@ -73,7 +63,7 @@ Clip make_in_place(const Clip& src, const Skeleton& sk, const ClipAnalysis& a, f
   std::vector<glm::mat4> model(nj);
   std::vector<glm::vec3> hips_xz(n);
   for (int f = 0; f < n; ++f) {
-    frame_model(c, sk, f, model);
+    clip_frame_model(c, sk, f, model);
     hips_xz[f] = translation_of(model[hips]);
     hips_xz[f].y = 0.0f;
   }
@@ -99,7 +89,7 @@ float clip_facing(const Clip& c, const Skeleton& sk) {
   std::vector<glm::mat4> model(sk.num_joints());
   glm::vec3 sum(0.0f);
   for (int f = 0; f < c.num_frames; ++f) {
-    frame_model(c, sk, f, model);
+    clip_frame_model(c, sk, f, model);
     const glm::vec3 lr =
         translation_of(model[sk.hip(Side::kLeft)]) - translation_of(model[sk.hip(Side::kRight)]);
     sum += glm::cross(lr, glm::vec3(0, 1, 0));
@@ -192,7 +182,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
   std::vector<glm::mat4> model(sk.num_joints());
   std::vector<glm::vec3> toe[2], ankle[2];
   for (int f = 0; f < n; ++f) {
-    frame_model(c, sk, f, model);
+    clip_frame_model(c, sk, f, model);
     for (int s = 0; s < 2; ++s) {
       toe[s].push_back(translation_of(model[sk.toe(static_cast<Side>(s))]));
       ankle[s].push_back(translation_of(model[sk.ankle(static_cast<Side>(s))]));
@@ -315,7 +305,7 @@ void add_contact_heights(const LocomotionClip& lc, const Skeleton& sk, ContactHe
       contact_frames(lc.analysis, 1, c.num_frames, c.fps, true)};
   for (int f = 0; f < c.num_frames; ++f) {
     if (!contact[0][f] && !contact[1][f]) continue;
-    frame_model(c, sk, f, model);
+    clip_frame_model(c, sk, f, model);
     for (int s = 0; s < 2; ++s) {
       if (!contact[s][f]) continue;
       out->toe[s].push_back(model[sk.toe(static_cast<Side>(s))][3].y);
@@ -352,7 +342,7 @@ LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
   int best = 0;
   float best_score = 1e9f;
   for (int f = 0; f < g.num_frames; ++f) {
-    frame_model(g, sk, f, model);
+    clip_frame_model(g, sk, f, model);
     glm::vec3 d =
         translation_of(model[sk.toe(Side::kLeft)]) - translation_of(model[sk.toe(Side::kRight)]);
     const float planted = gait.toe_height_m[0][f] + gait.toe_height_m[1][f] +
@@ -510,7 +500,7 @@ Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, f
   std::vector<glm::mat4> model(src.num_joints());
   std::vector<glm::quat> dst_model(nd);
   for (int f = 0; f < clip.num_frames; ++f) {
-    frame_model(clip, src, f, model);
+    clip_frame_model(clip, src, f, model);
     for (int j = 0; j < nd; ++j) {
       const size_t o = static_cast<size_t>(f) * nd + j;
       const int parent = dst.parents[j];

@@ -45,12 +45,7 @@ std::vector<glm::vec3> joint_track(const Clip& c, const Skeleton& sk, int joint)
   std::vector<glm::mat4> model(sk.num_joints());
   std::vector<glm::vec3> out;
   for (int f = 0; f < c.num_frames; ++f) {
-    LocalToModelJob{&sk,
-                    {c.frame_rotations(f), static_cast<size_t>(c.num_joints)},
-                    {c.frame_translations(f), static_cast<size_t>(c.num_joints)},
-                    glm::mat4(1.0f),
-                    model}
-        .run();
+    clip_frame_model(c, sk, f, model);
     out.push_back(translation_of(model[joint]));
   }
   return out;
