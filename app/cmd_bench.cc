@@ -27,10 +27,9 @@ namespace {
 
 constexpr int kWarmupFrames = 30;
 constexpr float kMinPairSearch_m = 3.0f;  // closest-approach search radius of the statistics
+// The metrics and stage timings are streamed in fixed memory: a run of any length keeps flat
+// memory (bench/soak.sh checks it).
 constexpr int kMaxFrames = 10'000'000;
-// MetricsRecorder reserves agents x frames_hint samples up front: a hint of a minute keeps a long
-// run (up to kMaxFrames) from reserving gigabytes before its first frame; vectors grow past it.
-constexpr int kMaxMetricsFramesHint = 3600;
 
 struct BenchOptions {
   CrowdOptions crowd;
@@ -96,8 +95,7 @@ void run_bench(const BenchOptions& o) {
   const LocomotionLibrary& library = session->library();
   const MediatorParams& params = session->params();
   const size_t capacity = std::max<size_t>(crowd.capacity(), 1);
-  MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity,
-                          static_cast<size_t>(std::min(frames, kMaxMetricsFramesHint)));
+  MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity);
   std::optional<JointDumpWriter> dump;
   if (!o.dump_joints.empty()) {
     auto opened =
@@ -109,7 +107,7 @@ void run_bench(const BenchOptions& o) {
   std::optional<OffscreenScene> scene;
   if (o.render) scene.emplace(open_offscreen_scene("bench", *session, o.size));
 
-  StageTimer timer(kWarmupFrames, frames);
+  StageTimer timer(kWarmupFrames);
   CrowdReport crowd_stats;
   double live_sum = 0.0, speed_sum = 0.0;
   int64_t speed_samples = 0;
