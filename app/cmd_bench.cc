@@ -215,11 +215,10 @@ void run_bench(const BenchOptions& o) {
       }
     }
     for (size_t i = 0; i < frame.size(); ++i) {
-      window.non_finite_crowd += !std::isfinite(frame.positions[i].x) +
-                                 !std::isfinite(frame.positions[i].y) +
-                                 !std::isfinite(frame.velocities[i].x) +
-                                 !std::isfinite(frame.velocities[i].y) +
-                                 !std::isfinite(frame.thetas[i]);
+      window.non_finite_crowd +=
+          !std::isfinite(frame.positions[i].x) + !std::isfinite(frame.positions[i].y) +
+          !std::isfinite(frame.velocities[i].x) + !std::isfinite(frame.velocities[i].y) +
+          !std::isfinite(frame.thetas[i]);
     }
     const auto now = StageTimer::Clock::now();
     if (progress_every > 0) {
@@ -229,16 +228,16 @@ void run_bench(const BenchOptions& o) {
       window.total_ms_sum += frame_total_ms;
       window.total_ms_max = std::max(window.total_ms_max, frame_total_ms);
       if ((f + 1) % progress_every == 0 || f + 1 == frames) {
-        const double wall_ms = std::chrono::duration<double, std::milli>(now - window.start).count();
+        const double wall_ms =
+            std::chrono::duration<double, std::milli>(now - window.start).count();
         std::fprintf(stderr,
                      "{\"frame\": %d, \"sim_time_s\": %.3f, \"wall_s\": %.3f, "
                      "\"live_agents\": %zu, \"live_tracks\": %zu, \"frame_ms\": %.4f, "
                      "\"frame_ms_max\": %.4f, \"wall_ms_per_frame\": %.4f, "
                      "\"us_per_agent_frame\": %.4f, \"rss_kib\": %lld, "
                      "\"non_finite\": {\"crowd\": %lld, \"poses\": %lld, \"joints\": %lld}}\n",
-                     f + 1, crowd.time_s(),
-                     std::chrono::duration<double>(now - started).count(), frame.size(),
-                     metrics.num_live_tracks(), window.total_ms_sum / window.frames,
+                     f + 1, crowd.time_s(), std::chrono::duration<double>(now - started).count(),
+                     frame.size(), metrics.num_live_tracks(), window.total_ms_sum / window.frames,
                      window.total_ms_max, wall_ms / window.frames,
                      window.agent_frames > 0
                          ? 1000.0 * window.total_ms_sum / static_cast<double>(window.agent_frames)

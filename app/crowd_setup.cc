@@ -188,8 +188,8 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
   if (o.loop) {
     // Round k draws the scenario's agents with seed + k; a round begins when the last one left.
     const std::string sim_name = o.sim;
-    auto rounds = RestartingCrowd::create(
-        [scenario, num_agents, seed, sim_name, threads](int round) {
+    auto rounds =
+        RestartingCrowd::create([scenario, num_agents, seed, sim_name, threads](int round) {
           return make_simulation(scenario, num_agents, seed + static_cast<uint64_t>(round),
                                  sim_name, threads, nullptr);
         });

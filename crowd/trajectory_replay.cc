@@ -274,9 +274,8 @@ Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(
   if (out_pedestrian_ids) *out_pedestrian_ids = table->ped_ids;  // sorted: tracks are by id
   const size_t slash = path.find_last_of('/');
   std::string name = "replay " + (slash == std::string::npos ? path : path.substr(slash + 1));
-  return std::unique_ptr<CrowdSource>(
-      new TrajectoryReplay(std::move(name), *table, static_cast<double>(options.frame_time_s),
-                           options.loop));
+  return std::unique_ptr<CrowdSource>(new TrajectoryReplay(
+      std::move(name), *table, static_cast<double>(options.frame_time_s), options.loop));
 }
 
 }  // namespace gk

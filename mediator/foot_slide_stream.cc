@@ -80,8 +80,8 @@ void FootSlideStream::decide(Foot& f, const Frame& x, Totals& t) const {
 void FootSlideStream::finish_foot(size_t foot, Foot& f, Totals& t) const {
   while (f.decided < f.added) decide(f, ring_at(foot, f.decided), t);
   if (f.in_run && f.run_frames >= 2) {
-    t.drift_sum_cm += 100.0 * std::hypot(f.prev_xz.x - f.run_start_xz.x,
-                                         f.prev_xz.y - f.run_start_xz.y);
+    t.drift_sum_cm +=
+        100.0 * std::hypot(f.prev_xz.x - f.run_start_xz.x, f.prev_xz.y - f.run_start_xz.y);
     ++t.intervals;
   }
   f.in_run = false;

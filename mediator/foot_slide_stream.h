@@ -30,10 +30,10 @@
 namespace gk {
 
 struct FootSlideResult {
-  SlideStats stats;         // num_samples saturates at INT_MAX; `samples` is the count
-  int64_t samples = 0;      // slide samples (pairs of contact frames)
-  int64_t intervals = 0;    // contact intervals (drift)
-  float toe_band_excess_m = 0.0f;    // see above; 0 when the result is METRICS.md's exactly
+  SlideStats stats;                // num_samples saturates at INT_MAX; `samples` is the count
+  int64_t samples = 0;             // slide samples (pairs of contact frames)
+  int64_t intervals = 0;           // contact intervals (drift)
+  float toe_band_excess_m = 0.0f;  // see above; 0 when the result is METRICS.md's exactly
   float ankle_band_excess_m = 0.0f;
 };
 
@@ -71,7 +71,7 @@ class FootSlideStream {
     bool prev_contact = false, in_run = false;
     int64_t added = 0, decided = 0;
     int64_t run_frames = 0;
-    float min_toe_y = 0.0f, min_ankle_y = 0.0f;    // over every frame added
+    float min_toe_y = 0.0f, min_ankle_y = 0.0f;                      // over every frame added
     float max_contact_toe_y = -1e30f, max_contact_ankle_y = -1e30f;  // over decided contacts
     glm::vec2 prev_xz{0.0f}, run_start_xz{0.0f};  // toe (x, z) of the last decided frame
   };

@@ -102,8 +102,7 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
     if (std::isfinite(frame.thetas[i])) {
       const float err = std::abs(wrap_pi(poses.upper_heading(slot_i) - frame.thetas[i])) * kDeg;
       facing_.add(err);
-      const float asked =
-          std::abs(wrap_pi(frame.thetas[i] - poses.pelvis_heading(slot_i))) * kDeg;
+      const float asked = std::abs(wrap_pi(frame.thetas[i] - poses.pelvis_heading(slot_i))) * kDeg;
       if (asked <= P.torsion_limit_deg) facing_within_.add(err);
     }
     // A simulator's garbage position (sanitised by the mediator) has no distance to measure.

@@ -9,7 +9,7 @@
 //     accelerations) and 2 s of its feet for METRICS.md v1's contact band (see
 //     mediator/foot_slide_stream.h for that band's documented error);
 //   - an agent's track is folded into the totals and released when the agent leaves.
-// docs/metrics_streaming.md gives the error of every figure in METRICS.md's terms.
+// docs/metrics.md gives the error of every figure in METRICS.md's terms.
 
 #include <cstdint>
 #include <optional>
@@ -82,9 +82,9 @@ class MetricsRecorder {
   FeetReference feet_reference_;
   ViewerFeetStats feet_floor_;
   int64_t frame_ = 0;
-  std::vector<Track> tracks_;              // [slot]
-  std::vector<ViewerTrack> feet_tracks_;   // [slot]
-  FootSlideStream slide_;                  // feet [slot * 2 + side]
+  std::vector<Track> tracks_;             // [slot]
+  std::vector<ViewerTrack> feet_tracks_;  // [slot]
+  FootSlideStream slide_;                 // feet [slot * 2 + side]
   ViewerFeetAccumulator feet_;
   StreamSummary torsion_, facing_, facing_within_, heading_, root_error_, rate_;
   double feedback_change_sum_ = 0.0;

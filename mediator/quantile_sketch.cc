@@ -79,8 +79,7 @@ double QuantileSketch::nearest_rank(double q) const {
 
 double QuantileSketch::floor_rank(double q) const {
   if (count_ == 0) return 0.0;
-  const auto k =
-      static_cast<uint64_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(count_));
+  const auto k = static_cast<uint64_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(count_));
   return value_at_rank(std::min(k, count_ - 1));
 }
 

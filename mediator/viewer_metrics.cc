@@ -126,8 +126,8 @@ void ViewerFeetAccumulator::add_frame(ViewerTrack& t, const LimbFrame& cur, floa
   ++agent_frames_;
   seconds_ += static_cast<double>(dt);
   for (int s = 0; s < 2; ++s) {
-    const double depth = std::max({0.0, floor_toe[s] - cur.joint[kToe][s].y,
-                                   floor_ankle[s] - cur.joint[kAnkle][s].y});
+    const double depth = std::max(
+        {0.0, floor_toe[s] - cur.joint[kToe][s].y, floor_ankle[s] - cur.joint[kAnkle][s].y});
     depth_cm_.add(static_cast<float>(100.0 * depth));
     if (depth > kPenetrationCountM) ++deep_;
   }
@@ -152,7 +152,8 @@ void ViewerFeetAccumulator::add_frame(ViewerTrack& t, const LimbFrame& cur, floa
     bool pop = false;
     for (int j = 0; j < kNumLimbJoints && !pop; ++j) {
       for (int s = 0; s < 2 && !pop; ++s) {
-        const glm::dvec3 d2 = glm::dvec3(cur.joint[j][s]) - 2.0 * glm::dvec3(t.last[1].joint[j][s]) +
+        const glm::dvec3 d2 = glm::dvec3(cur.joint[j][s]) -
+                              2.0 * glm::dvec3(t.last[1].joint[j][s]) +
                               glm::dvec3(t.last[0].joint[j][s]);
         const double a = glm::length(d2) / (static_cast<double>(dt) * dt);
         pop = a > 2.0f * ref_.accel_m_s2[j][s];

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include <glm/ext/vector_double3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
-#include <glm/ext/vector_double3.hpp>
 
 #include "mediator/locomotion_library.h"
 #include "mediator/quantile_sketch.h"

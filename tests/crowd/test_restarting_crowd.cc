@@ -14,8 +14,8 @@ namespace {
 // `n` agents with ids 0..n-1; agent i leaves after i + 1 steps.
 class Leaving final : public CrowdSource {
  public:
-  explicit Leaving(size_t n) : ids_(n), pos_(n, glm::vec2(0.0f)), vel_(n, glm::vec2(0.0f)),
-                               theta_(n, 0.0f), live_(n) {
+  explicit Leaving(size_t n)
+      : ids_(n), pos_(n, glm::vec2(0.0f)), vel_(n, glm::vec2(0.0f)), theta_(n, 0.0f), live_(n) {
     for (size_t i = 0; i < n; ++i) ids_[i] = static_cast<uint32_t>(i);
   }
   std::string name() const override { return "leaving"; }
@@ -28,8 +28,10 @@ class Leaving final : public CrowdSource {
   // The agents still here are the last `live_` ids.
   AgentFrame frame() const override {
     const size_t first = ids_.size() - live_;
-    return {{ids_.data() + first, live_}, {pos_.data() + first, live_},
-            {vel_.data() + first, live_}, {theta_.data() + first, live_}};
+    return {{ids_.data() + first, live_},
+            {pos_.data() + first, live_},
+            {vel_.data() + first, live_},
+            {theta_.data() + first, live_}};
   }
   FeedbackPolicy feedback_policy() const override { return FeedbackPolicy::kIgnored; }
   Status apply_feedback(const AgentFeedback&) override { return Status::Ok(); }
@@ -83,8 +85,7 @@ TEST(RestartingCrowd, ReportsAFactoryErrorAndARoundTooBig) {
   ASSERT_TRUE((*growing)->step(0.1f).ok());
   const Status big = (*growing)->step(0.1f);
   EXPECT_FALSE(big.ok());
-  EXPECT_NE(big.message().find("more than the 1 of the first"), std::string::npos)
-      << big.message();
+  EXPECT_NE(big.message().find("more than the 1 of the first"), std::string::npos) << big.message();
 }
 
 }  // namespace

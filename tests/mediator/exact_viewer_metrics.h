@@ -111,10 +111,10 @@ inline void add_exact_track(const LimbTrack& t, const FeetReference& ref, float 
     bool skates = false;
     for (int s = 0; s < 2; ++s) {
       const glm::dvec3 cur = toe_at(s, k);
-      const bool contact = cur.y - floor_toe[s] <= A::kNearFloorM &&
-                           prev[s].y - floor_toe[s] <= A::kNearFloorM;
-      if (contact && std::hypot(cur.x - prev[s].x, cur.z - prev[s].z) * A::kGmdRateHz >
-                         A::kGmdSkateM_S) {
+      const bool contact =
+          cur.y - floor_toe[s] <= A::kNearFloorM && prev[s].y - floor_toe[s] <= A::kNearFloorM;
+      if (contact &&
+          std::hypot(cur.x - prev[s].x, cur.z - prev[s].z) * A::kGmdRateHz > A::kGmdSkateM_S) {
         skates = true;
       }
       prev[s] = cur;

@@ -54,7 +54,7 @@ struct StoredTrack {
 // Every sample of a run, stored: what MetricsRecorder streams, computed here from the same
 // mediator and poses with METRICS.md's definitions.
 struct ExactRun {
-  std::vector<StoredTrack> tracks;  // finished and open
+  std::vector<StoredTrack> tracks;                  // finished and open
   std::map<uint32_t, std::pair<size_t, int>> open;  // id -> (track, last frame)
   std::vector<double> torsion, facing, facing_within, heading, root_error, rate;
   double feedback_sum = 0.0;
@@ -90,7 +90,8 @@ struct ExactRun {
       const size_t k = t.root.size() - 1;
       if (k >= 3) {
         const auto& p = t.root;
-        const glm::vec2 j = (p[k] - 3.0f * p[k - 1] + 3.0f * p[k - 2] - p[k - 3]) / (kDt * kDt * kDt);
+        const glm::vec2 j =
+            (p[k] - 3.0f * p[k - 1] + 3.0f * p[k - 2] - p[k - 3]) / (kDt * kDt * kDt);
         max_jerk = std::max(max_jerk, static_cast<double>(glm::length(j)));
       }
       ++agent_frames;
@@ -294,11 +295,10 @@ void compare(CrowdSource& crowd, const LocomotionLibrary& lib, int frames, const
       what, exact.tracks.size(), static_cast<long long>(r.agent_frames), r.slide.mean_cm_s,
       r.slide.p95_cm_s, r.slide.skate_ratio, r.slide.drift_cm_per_step,
       static_cast<long long>(r.slide_samples), metrics_md.stats.mean_cm_s,
-      metrics_md.stats.p95_cm_s, metrics_md.stats.skate_ratio,
-      metrics_md.stats.drift_cm_per_step, metrics_md.stats.num_samples,
-      1000.0 * r.slide_toe_band_excess_m, 1000.0 * r.slide_ankle_band_excess_m,
-      r.feet.support_slide_p95_cm_s, v2.support_p95(), r.torsion_deg.p95,
-      nearest_rank(exact.torsion, 0.95));
+      metrics_md.stats.p95_cm_s, metrics_md.stats.skate_ratio, metrics_md.stats.drift_cm_per_step,
+      metrics_md.stats.num_samples, 1000.0 * r.slide_toe_band_excess_m,
+      1000.0 * r.slide_ankle_band_excess_m, r.feet.support_slide_p95_cm_s, v2.support_p95(),
+      r.torsion_deg.p95, nearest_rank(exact.torsion, 0.95));
 }
 
 std::unique_ptr<CrowdSource> social(const std::string& name, int agents, uint64_t seed) {
@@ -314,7 +314,8 @@ std::unique_ptr<CrowdSource> social(const std::string& name, int agents, uint64_
 
 TEST(MetricsStreaming, PlazaWithCmuClipsEqualsTheExactFigures) {
   GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
-  auto lib = test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
+  auto lib =
+      test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
   ASSERT_TRUE(lib.ok()) << lib.message();
   auto crowd = social("plaza", 36, 1);
   compare(*crowd, *lib, 6000, "plaza, 36 agents, CMU walk and run");
