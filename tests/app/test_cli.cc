@@ -196,6 +196,8 @@ TEST(Cli, BenchLoopsAScenarioAndReportsProgress) {
     EXPECT_GT(j["rss_kib"].get<int64_t>(), 0);
     EXPECT_GT(j["frame_ms"].get<double>(), 0.0);
     EXPECT_GE(j["frame_ms_max"].get<double>(), j["frame_ms"].get<double>());
+    EXPECT_GT(j["cpu_ms"].get<double>(), 0.0);
+    EXPECT_GT(j["cpu_us_per_agent_frame"].get<double>(), 0.0);
     for (const char* what : {"crowd", "poses", "joints"}) {
       EXPECT_EQ(j["non_finite"][what].get<int64_t>(), 0) << what;
     }
