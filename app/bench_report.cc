@@ -29,26 +29,18 @@ const char* stage_name(Stage stage) {
   return kNames[static_cast<size_t>(stage)];
 }
 
-StageTimer::StageTimer(int warmup_frames, int expected_frames) : warmup_frames_(warmup_frames) {
-  const auto timed = static_cast<size_t>(std::max(0, expected_frames - warmup_frames));
-  for (auto& s : samples_ms_) s.reserve(timed);
-}
+StageTimer::StageTimer(int warmup_frames) : warmup_frames_(warmup_frames) {}
 
 void StageTimer::record(Stage stage, int frame, double ms) {
   if (frame < warmup_frames_) return;
-  samples_ms_[static_cast<size_t>(stage)].push_back(ms);
+  samples_ms_[static_cast<size_t>(stage)].add(ms);
 }
 
 std::optional<TimingStat> StageTimer::stat(Stage stage) const {
-  std::vector<double> v = samples_ms_[static_cast<size_t>(stage)];
-  if (v.empty()) return std::nullopt;
-  std::sort(v.begin(), v.end());
-  // Nearest-rank percentiles: an actual sample, no interpolation between frames.
-  auto rank = [&](double q) {
-    const auto k = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size())));
-    return v[std::clamp<size_t>(k, 1, v.size()) - 1];
-  };
-  return TimingStat{rank(0.5), rank(0.95)};
+  const QuantileSketch& v = samples_ms_[static_cast<size_t>(stage)];
+  if (v.count() == 0) return std::nullopt;
+  // Nearest-rank percentiles: an actual sample (to the sketch's 0.1%), no interpolation.
+  return TimingStat{v.nearest_rank(0.5), v.nearest_rank(0.95)};
 }
 
 json to_json(const BenchReport& r) {
@@ -216,7 +208,7 @@ nlohmann::json metrics_to_json(const MetricsReport& m, const LocomotionLibrary& 
       {"foot_slide_p95_cm_s", slid ? json(m.slide.p95_cm_s) : json(nullptr)},
       {"skate_ratio", slid ? json(m.slide.skate_ratio) : json(nullptr)},
       {"foot_drift_cm_per_step", slid ? json(m.slide.drift_cm_per_step) : json(nullptr)},
-      {"foot_slide_samples", m.slide.num_samples},
+      {"foot_slide_samples", m.slide_samples},
       {"foot_slide_floor_cm_s", floor_n ? json(floor_sum / floor_n) : json(nullptr)},
       {"foot_slide_floor_per_clip_cm_s", floors},
       {"torsion_deg",

@@ -16,6 +16,7 @@
 #include "common/status.h"
 #include "mediator/locomotion_library.h"
 #include "mediator/metrics.h"
+#include "mediator/quantile_sketch.h"
 
 namespace gk::app {
 
@@ -30,11 +31,12 @@ struct TimingStat {
 };
 
 // Collects one duration per stage per frame, ignoring the first `warmup_frames` frames (caches,
-// page faults, thread start-up). Storage is reserved up front so timing does not allocate.
+// page faults, thread start-up), into a fixed QuantileSketch per stage: memory does not grow with
+// the frames and timing does not allocate. Median and p95 are within 0.1% of the exact ones.
 class StageTimer {
  public:
   using Clock = std::chrono::steady_clock;
-  StageTimer(int warmup_frames, int expected_frames);
+  explicit StageTimer(int warmup_frames);
 
   void record(Stage stage, int frame, double ms);
   // Runs fn() and records its duration for `stage` on `frame`; returns what fn returns.
@@ -59,7 +61,7 @@ class StageTimer {
 
  private:
   int warmup_frames_;
-  std::array<std::vector<double>, kNumStages> samples_ms_;
+  std::array<QuantileSketch, kNumStages> samples_ms_;
 };
 
 // Agent statistics over the run (all frames, warm-up included).

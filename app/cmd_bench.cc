@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -27,10 +29,9 @@ namespace {
 
 constexpr int kWarmupFrames = 30;
 constexpr float kMinPairSearch_m = 3.0f;  // closest-approach search radius of the statistics
+// The metrics and stage timings are streamed in fixed memory: a run of any length keeps flat
+// memory (bench/soak.sh checks it).
 constexpr int kMaxFrames = 10'000'000;
-// MetricsRecorder reserves agents x frames_hint samples up front: a hint of a minute keeps a long
-// run (up to kMaxFrames) from reserving gigabytes before its first frame; vectors grow past it.
-constexpr int kMaxMetricsFramesHint = 3600;
 
 struct BenchOptions {
   CrowdOptions crowd;
@@ -40,7 +41,61 @@ struct BenchOptions {
   std::string dump_joint_names;
   bool render = false;
   std::string size = "1280x720";
+  std::string progress_every = "0";
 };
+
+// One line of --progress-every: the window of frames since the previous line.
+struct ProgressWindow {
+  int frames = 0;
+  int64_t agent_frames = 0;
+  double total_ms_sum = 0.0, total_ms_max = 0.0;
+  double cpu_ms_sum = 0.0;  // CPU time of the process (all threads) in the pipeline
+  StageTimer::Clock::time_point start;
+  int64_t non_finite_crowd = 0;  // since the start of the run
+};
+
+// CPU time of this process, all threads [ms]: unlike wall time, it does not count the time the
+// process waits while other programs run (a soak on a shared machine).
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+// Resident memory of this process [KiB] (VmRSS of /proc/self/status), -1 where unavailable.
+int64_t resident_kib() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return -1;
+  char line[256];
+  int64_t kib = -1;
+  while (std::fgets(line, sizeof(line), f)) {
+    long long v = 0;
+    if (std::sscanf(line, "VmRSS: %lld kB", &v) == 1) {
+      kib = v;
+      break;
+    }
+  }
+  std::fclose(f);
+  return kib;
+}
+
+int64_t count_non_finite(std::span<const float> values) {
+  int64_t n = 0;
+  for (float v : values) n += !std::isfinite(v);
+  return n;
+}
+
+// NaN or infinite values in the world transforms of the frame's agents.
+int64_t non_finite_poses(const AgentFrame& frame, const Mediator& mediator,
+                         const PoseSynthesizer& poses) {
+  int64_t n = 0;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    for (const glm::mat4& m : poses.world(mediator.plans().slot_of_agent[i])) {
+      n += count_non_finite({&m[0][0], 16});
+    }
+  }
+  return n;
+}
 
 [[noreturn]] void fail(int code, const std::string& message) { app::fail("bench", code, message); }
 
@@ -96,8 +151,7 @@ void run_bench(const BenchOptions& o) {
   const LocomotionLibrary& library = session->library();
   const MediatorParams& params = session->params();
   const size_t capacity = std::max<size_t>(crowd.capacity(), 1);
-  MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity,
-                          static_cast<size_t>(std::min(frames, kMaxMetricsFramesHint)));
+  MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity);
   std::optional<JointDumpWriter> dump;
   if (!o.dump_joints.empty()) {
     auto opened =
@@ -109,14 +163,19 @@ void run_bench(const BenchOptions& o) {
   std::optional<OffscreenScene> scene;
   if (o.render) scene.emplace(open_offscreen_scene("bench", *session, o.size));
 
-  StageTimer timer(kWarmupFrames, frames);
+  StageTimer timer(kWarmupFrames);
   CrowdReport crowd_stats;
   double live_sum = 0.0, speed_sum = 0.0;
   int64_t speed_samples = 0;
   const auto started = StageTimer::Clock::now();
   auto last_progress = started;
+  const int progress_every =
+      parse_number<int>("bench", o.progress_every, "--progress-every", 0, kMaxFrames);
+  ProgressWindow window;
+  window.start = started;
   for (int f = 0; f < frames; ++f) {
     const auto frame_start = StageTimer::Clock::now();
+    const double frame_cpu_start_ms = progress_every > 0 ? process_cpu_ms() : 0.0;
     const Status stepped = session->step(kFrameTime_s);
     if (!stepped.ok()) fail(1, "frame " + std::to_string(f) + ": " + stepped.message());
     timer.record(Stage::kSim, f, session->times().sim_ms);
@@ -138,7 +197,9 @@ void run_bench(const BenchOptions& o) {
       });
       if (!drawn.ok()) fail(1, "frame " + std::to_string(f) + ": " + drawn.message());
     }
-    timer.record(Stage::kTotal, f, StageTimer::ms_since(frame_start));
+    const double frame_total_ms = StageTimer::ms_since(frame_start);
+    const double frame_cpu_ms = progress_every > 0 ? process_cpu_ms() - frame_cpu_start_ms : 0.0;
+    timer.record(Stage::kTotal, f, frame_total_ms);
 
     // Measurement, not part of the timed pipeline.
     const AgentFrame& frame = session->frame();
@@ -165,8 +226,51 @@ void run_bench(const BenchOptions& o) {
             std::min(crowd_stats.min_pair_distance_m.value_or(kMinPairSearch_m), *d);
       }
     }
+    for (size_t i = 0; i < frame.size(); ++i) {
+      window.non_finite_crowd +=
+          !std::isfinite(frame.positions[i].x) + !std::isfinite(frame.positions[i].y) +
+          !std::isfinite(frame.velocities[i].x) + !std::isfinite(frame.velocities[i].y) +
+          !std::isfinite(frame.thetas[i]);
+    }
     const auto now = StageTimer::Clock::now();
-    if (now - last_progress >= std::chrono::seconds(1)) {
+    if (progress_every > 0) {
+      // One JSON line per window on stderr, for bench/soak.sh: memory, time per frame, NaN.
+      ++window.frames;
+      window.agent_frames += static_cast<int64_t>(frame.size());
+      window.total_ms_sum += frame_total_ms;
+      window.total_ms_max = std::max(window.total_ms_max, frame_total_ms);
+      window.cpu_ms_sum += frame_cpu_ms;
+      if ((f + 1) % progress_every == 0 || f + 1 == frames) {
+        const double wall_ms =
+            std::chrono::duration<double, std::milli>(now - window.start).count();
+        std::fprintf(stderr,
+                     "{\"frame\": %d, \"sim_time_s\": %.3f, \"wall_s\": %.3f, "
+                     "\"live_agents\": %zu, \"live_tracks\": %zu, \"frame_ms\": %.4f, "
+                     "\"frame_ms_max\": %.4f, \"wall_ms_per_frame\": %.4f, "
+                     "\"us_per_agent_frame\": %.4f, \"cpu_ms\": %.4f, "
+                     "\"cpu_us_per_agent_frame\": %.4f, \"rss_kib\": %lld, "
+                     "\"non_finite\": {\"crowd\": %lld, \"poses\": %lld, \"joints\": %lld}}\n",
+                     f + 1, crowd.time_s(), std::chrono::duration<double>(now - started).count(),
+                     frame.size(), metrics.num_live_tracks(), window.total_ms_sum / window.frames,
+                     window.total_ms_max, wall_ms / window.frames,
+                     window.agent_frames > 0
+                         ? 1000.0 * window.total_ms_sum / static_cast<double>(window.agent_frames)
+                         : 0.0,
+                     window.cpu_ms_sum / window.frames,
+                     window.agent_frames > 0
+                         ? 1000.0 * window.cpu_ms_sum / static_cast<double>(window.agent_frames)
+                         : 0.0,
+                     static_cast<long long>(resident_kib()),
+                     static_cast<long long>(window.non_finite_crowd),
+                     static_cast<long long>(non_finite_poses(frame, mediator, poses)),
+                     static_cast<long long>(metrics.num_non_finite()));
+        std::fflush(stderr);
+        const int64_t keep_crowd = window.non_finite_crowd;
+        window = ProgressWindow();
+        window.start = now;
+        window.non_finite_crowd = keep_crowd;
+      }
+    } else if (now - last_progress >= std::chrono::seconds(1)) {
       last_progress = now;
       std::fprintf(stderr, "\rbench: frame %d/%d, %.3f ms/frame (wall, incl. statistics)   ", f + 1,
                    frames,
@@ -203,11 +307,20 @@ void run_bench(const BenchOptions& o) {
   report.joints = library.skeleton->num_joints();
   report.clips = library.clip_names();
   report.takes = describe_takes(library);
-  report.metrics = metrics_to_json(metrics.finish(), library);
+  const MetricsReport measured = metrics.finish();
+  report.metrics = metrics_to_json(measured, library);
   if (dump) {
     if (Status s = dump->close(); !s.ok()) fail(1, s.message());
   }
   std::fputs(summary(report).c_str(), stdout);
+  // METRICS.md v1's contact band is decided FootSlideStream::kLag_s late (docs/metrics.md).
+  std::printf("  v1 contact band excess (0 = METRICS.md exactly): toe %.3f mm, ankle %.3f mm\n",
+              1000.0 * measured.slide_toe_band_excess_m,
+              1000.0 * measured.slide_ankle_band_excess_m);
+  if (measured.non_finite > 0) {
+    std::printf("  NaN or infinite joint coordinates or samples: %lld\n",
+                static_cast<long long>(measured.non_finite));
+  }
   if (!o.json.empty()) {
     if (const Status written = write_report_json(report, o.json); !written.ok()) {
       fail(1, written.message());
@@ -232,6 +345,16 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--render", options->render,
                 "Also render every frame offscreen (EGL) and time the upload and render stages");
   cmd->add_option("--size", options->size, "Frame size of --render, WxH (default 1280x720)");
+  cmd->add_flag("--loop", options->crowd.loop,
+                "Run the crowd round and round: a replayed file starts over after its last "
+                "sample; a scenario whose agents leave at their goal starts a new round (seed + 1, "
+                "...) when the last has left");
+  cmd->add_option("--progress-every", options->progress_every,
+                  "Every N frames, one JSON line on stderr: frame, sim_time_s, wall_s, "
+                  "live_agents, live_tracks, frame_ms (mean pipeline time of those frames), "
+                  "frame_ms_max, wall_ms_per_frame, us_per_agent_frame, cpu_ms and "
+                  "cpu_us_per_agent_frame (process CPU time of the pipeline), rss_kib, non_finite "
+                  "counts (0 = off)");
   cmd->add_option("--dump-joints", options->dump_joints,
                   "Write world joint positions per frame and agent to this CSV");
   cmd->add_option("--dump-joint-names", options->dump_joint_names,

@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "common/file_io.h"
 #include "crowd/detour_crowd.h"
+#include "crowd/restarting_crowd.h"
 #include "crowd/social_forces.h"
 #include "crowd/trajectory_replay.h"
 
@@ -118,6 +119,32 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
   cmd->add_option("--params", o->params_file, "JSON file of mediator parameters");
 }
 
+namespace {
+
+// The scenario's agents drawn for `seed` on the named simulator; out_social (optional) receives
+// the social-forces simulator when that is the one built.
+Result<std::unique_ptr<CrowdSource>> make_simulation(const Scenario& scenario, int num_agents,
+                                                     uint64_t seed, const std::string& sim,
+                                                     int threads, SocialForces** out_social) {
+  auto agents = expand_agents(scenario, num_agents, seed);
+  if (!agents.ok()) return agents.status();
+  if (sim == "social") {
+    SocialForceParams params;
+    params.threads = threads;
+    auto social = SocialForces::create(scenario, *agents, params);
+    if (!social.ok()) return social.status();
+    if (out_social) *out_social = social->get();
+    return std::unique_ptr<CrowdSource>(std::move(social).value());
+  }
+  DetourParams params;
+  params.seed = seed;
+  auto detour = make_detour_crowd(scenario, *agents, params);
+  if (!detour.ok()) return detour.status();
+  return std::unique_ptr<CrowdSource>(std::move(detour).value());
+}
+
+}  // namespace
+
 CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
   const std::string& cmd = o.command;
   if (o.sim != "social" && o.sim != "detour") {
@@ -132,6 +159,7 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
       std::fprintf(stderr, "gaitkeeper %s: --agents ignored for replay\n", cmd.c_str());
     }
     ReplayOptions replay;
+    replay.loop = o.loop;
     replay.frame_time_s =
         parse_number<float>(cmd, o.trajectory_frame_time, "--trajectory-frame-time", 1e-3f, 60.0f);
     auto loaded = load_trajectory_replay(o.scenario, replay, &src.replay_ids);
@@ -155,8 +183,6 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
              " agents; pass a smaller --agents");
   }
   const Scenario scenario = scale_scenario(*loaded, num_agents);
-  auto agents = expand_agents(scenario, num_agents, seed);
-  if (!agents.ok()) fail(cmd, 2, agents.message());
   src.scenario_name = loaded->name;
   src.agents = num_agents;
   src.walls = scenario.walls;
@@ -164,20 +190,21 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
   src.bounds_min = scenario.bounds_min;
   src.bounds_max = scenario.bounds_max;
   src.has_bounds = true;
-  if (o.sim == "social") {
-    SocialForceParams params;
-    params.threads = threads;
-    auto sim = SocialForces::create(scenario, *agents, params);
-    if (!sim.ok()) fail(cmd, 2, sim.message());
-    src.social = sim->get();
-    src.crowd = std::move(sim).value();
-  } else {
-    DetourParams params;
-    params.seed = seed;
-    auto sim = make_detour_crowd(scenario, *agents, params);
-    if (!sim.ok()) fail(cmd, 2, sim.message());
-    src.crowd = std::move(sim).value();
+  if (o.loop) {
+    // Round k draws the scenario's agents with seed + k; a round begins when the last one left.
+    const std::string sim_name = o.sim;
+    auto rounds =
+        RestartingCrowd::create([scenario, num_agents, seed, sim_name, threads](int round) {
+          return make_simulation(scenario, num_agents, seed + static_cast<uint64_t>(round),
+                                 sim_name, threads, nullptr);
+        });
+    if (!rounds.ok()) fail(cmd, 2, rounds.message());
+    src.crowd = std::move(rounds).value();
+    return src;
   }
+  auto sim = make_simulation(scenario, num_agents, seed, o.sim, threads, &src.social);
+  if (!sim.ok()) fail(cmd, 2, sim.message());
+  src.crowd = std::move(sim).value();
   return src;
 }
 

@@ -36,6 +36,9 @@ struct CrowdOptions {
   std::string roles;  // JSON role manifest applied to every clip file (empty: roles detected)
   std::vector<std::string> sets;
   std::string params_file;
+  // Run the crowd round and round: a replayed file starts over after its last sample, a scenario
+  // starts a new round (seed + 1, ...) when every agent has left (bench --loop).
+  bool loop = false;
 };
 
 // Registers the options above on a subcommand. `scenario_required`: bench needs one; render and
@@ -54,7 +57,9 @@ T parse_number(const std::string& command, const std::string& text, const char* 
 
 struct CrowdSetup {
   std::unique_ptr<CrowdSource> crowd;
-  SocialForces* social = nullptr;  // set when the source is the social-forces simulator
+  // Set when the source is the social-forces simulator (not with `loop`, whose rounds each have
+  // their own).
+  SocialForces* social = nullptr;
   std::string scenario_name;
   int64_t agents = 0;
   // Geometry for the renderer and the camera; a replayed file has no walls and its bounds are

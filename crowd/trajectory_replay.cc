@@ -44,7 +44,7 @@ float pchip_slope(float d0, float d1, double h0, double h1) {
 
 class TrajectoryReplay final : public CrowdSource {
  public:
-  TrajectoryReplay(std::string name, const TrajectoryTable& table, double frame_time_s);
+  TrajectoryReplay(std::string name, const TrajectoryTable& table, double frame_time_s, bool loop);
 
   std::string name() const override { return name_; }
   Status step(float dt_s) override;
@@ -79,14 +79,18 @@ class TrajectoryReplay final : public CrowdSource {
   size_t num_live_ = 0;
   uint32_t next_start_ = 0;
   double time_s_ = 0.0;
+  // Looping: the file's time is time_s_ - loop_start_s_; it starts over after period_s_.
+  bool loop_ = false;
+  double period_s_ = 0.0;
+  double loop_start_s_ = 0.0;
   std::vector<uint32_t> out_ids_;
   std::vector<glm::vec2> out_positions_, out_velocities_;
   std::vector<float> out_thetas_;
 };
 
 TrajectoryReplay::TrajectoryReplay(std::string name, const TrajectoryTable& table,
-                                   double frame_time_s)
-    : name_(std::move(name)) {
+                                   double frame_time_s, bool loop)
+    : name_(std::move(name)), loop_(loop) {
   const size_t num_tracks = table.num_tracks();
   const size_t num_samples = table.frames.size();
   // The file's (x, y) become our (x, z) as they are (see the header): metres stay metres and the
@@ -160,6 +164,11 @@ TrajectoryReplay::TrajectoryReplay(std::string name, const TrajectoryTable& tabl
 
   cursor_.assign(sample_begin_.begin(), sample_begin_.end());
   theta_.assign(initial_theta_.begin(), initial_theta_.end());
+  // One sample step after the last sample: every pedestrian has left (their live intervals end
+  // kTimeEpsilon_s after their last sample) before anyone comes back.
+  double last_s = 0.0;
+  for (double t : sample_time_s_) last_s = std::max(last_s, t);
+  period_s_ = last_s + frame_time_s;
   live_.resize(capacity);
   out_ids_.resize(capacity);
   out_positions_.resize(capacity);
@@ -179,7 +188,17 @@ Status TrajectoryReplay::step(float dt_s) {
 }
 
 void TrajectoryReplay::update_live(float dt_s) {
-  const double t = time_s_;
+  if (loop_) {
+    while (time_s_ - loop_start_s_ >= period_s_) {
+      // Everyone has left (see period_s_): start over from the file's first frame.
+      loop_start_s_ += period_s_;
+      num_live_ = 0;
+      next_start_ = 0;
+      cursor_.assign(sample_begin_.begin(), sample_begin_.end());
+      theta_.assign(initial_theta_.begin(), initial_theta_.end());
+    }
+  }
+  const double t = time_s_ - loop_start_s_;
   // Drop tracks past their last sample, keeping the order of the others.
   size_t kept = 0;
   for (size_t i = 0; i < num_live_; ++i) {
@@ -255,8 +274,8 @@ Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(
   if (out_pedestrian_ids) *out_pedestrian_ids = table->ped_ids;  // sorted: tracks are by id
   const size_t slash = path.find_last_of('/');
   std::string name = "replay " + (slash == std::string::npos ? path : path.substr(slash + 1));
-  return std::unique_ptr<CrowdSource>(
-      new TrajectoryReplay(std::move(name), *table, static_cast<double>(options.frame_time_s)));
+  return std::unique_ptr<CrowdSource>(new TrajectoryReplay(
+      std::move(name), *table, static_cast<double>(options.frame_time_s), options.loop));
 }
 
 }  // namespace gk

@@ -17,6 +17,8 @@
 //
 // Errors (file and line): wrong column count, non-numbers, NaN/inf, frame not a whole number in
 // [0, 2^31), id not a whole number in [0, 2^32), duplicate (frame, id), no rows at all.
+//
+// With ReplayOptions::loop the file plays round and round for as long as it is stepped.
 
 #include <memory>
 #include <string>
@@ -31,6 +33,10 @@ struct ReplayOptions {
   // usual difference between consecutive frame numbers (10 in the ETH/UCY files). [s] [> 0]
   // Note: biwi_eth.txt is resampled from 6-frame annotations; its 10-id step spans ~0.667 s.
   float frame_time_s = 0.4f;
+  // Play the file again and again: one sample step after its last sample, it starts over from its
+  // first frame (time_s() keeps counting). Every pedestrian leaves before the file starts over,
+  // so each comes back as a new agent with its id (absent for at least that step).
+  bool loop = false;
 };
 
 // `out_pedestrian_ids` (optional) receives every pedestrian id of the file, sorted, so that an

@@ -106,104 +106,144 @@ FeetReference make_feet_reference(const LocomotionLibrary& library, float dt_s) 
   return ref;
 }
 
-void ViewerFeetAccumulator::add_track(const LimbTrack& t, float dt) {
-  const size_t n = t.root.size();
-  if (n == 0) return;
-  // Double precision throughout, so that a check recomputed from the joint dump (whose numbers
-  // reproduce these floats exactly) breaks ties between the feet the same way.
+// The METRICS.md v2 definitions, one frame at a time. Double precision throughout, so that a
+// check recomputed from the joint dump (whose numbers reproduce these floats exactly) breaks ties
+// between the feet the same way.
+void ViewerFeetAccumulator::add_frame(ViewerTrack& t, const LimbFrame& cur, float dt) {
   const double floor_toe[2] = {ref_.toe_floor_m[0], ref_.toe_floor_m[1]};
   const double floor_ankle[2] = {ref_.ankle_floor_m[0], ref_.ankle_floor_m[1]};
-  const auto& toe = t.joint[static_cast<int>(LimbJoint::kToe)];
-  const auto& ankle = t.joint[static_cast<int>(LimbJoint::kAnkle)];
-  auto rel = [&](int s, size_t f) { return static_cast<double>(toe[s][f].y) - floor_toe[s]; };
-  auto support = [&](size_t f) { return rel(1, f) < rel(0, f) ? 1 : 0; };
-  auto near = [&](int s, size_t f) { return rel(s, f) <= kNearFloorM; };
+  constexpr int kToe = static_cast<int>(LimbJoint::kToe);
+  constexpr int kAnkle = static_cast<int>(LimbJoint::kAnkle);
+  auto rel = [&](const LimbFrame& p, int s) {
+    return static_cast<double>(p.joint[kToe][s].y) - floor_toe[s];
+  };
+  auto support = [&](const LimbFrame& p) { return rel(p, 1) < rel(p, 0) ? 1 : 0; };
+  auto near = [&](const LimbFrame& p, int s) { return rel(p, s) <= kNearFloorM; };
   auto horizontal = [](const glm::vec3& a, const glm::vec3& b) {
     return std::hypot(static_cast<double>(a.x) - b.x, static_cast<double>(a.z) - b.z);
   };
-  agent_frames_ += static_cast<int64_t>(n);
-  seconds_ += n * static_cast<double>(dt);
-  for (size_t f = 0; f < n; ++f) {
-    for (int s = 0; s < 2; ++s) {
-      const double depth =
-          std::max({0.0, floor_toe[s] - toe[s][f].y, floor_ankle[s] - ankle[s][f].y});
-      depth_cm_.push_back(static_cast<float>(100.0 * depth));
-      if (depth > kPenetrationCountM) ++deep_;
-    }
-    if (f == 0) continue;
-    const int sup = support(f);
-    if (sup == support(f - 1) && near(sup, f) && near(sup, f - 1)) {
-      const double v = 100.0 * horizontal(toe[sup][f], toe[sup][f - 1]) / dt;
-      support_cm_s_.push_back(static_cast<float>(v));
+  const int64_t f = t.frames;
+  ++agent_frames_;
+  seconds_ += static_cast<double>(dt);
+  for (int s = 0; s < 2; ++s) {
+    const double depth = std::max(
+        {0.0, floor_toe[s] - cur.joint[kToe][s].y, floor_ankle[s] - cur.joint[kAnkle][s].y});
+    depth_cm_.add(static_cast<float>(100.0 * depth));
+    if (depth > kPenetrationCountM) ++deep_;
+  }
+  if (f >= 1) {
+    const LimbFrame& prev = t.last[1];
+    const int sup = support(cur);
+    if (sup == support(prev) && near(cur, sup) && near(prev, sup)) {
+      const double v = 100.0 * horizontal(cur.joint[kToe][sup], prev.joint[kToe][sup]) / dt;
+      support_cm_s_.add(static_cast<float>(v));
       if (v > kSkateCmS) ++support_skates_;
     }
-    const double root_speed = std::hypot(static_cast<double>(t.root[f].x) - t.root[f - 1].x,
-                                         static_cast<double>(t.root[f].y) - t.root[f - 1].y) /
+    const double root_speed = std::hypot(static_cast<double>(cur.root.x) - prev.root.x,
+                                         static_cast<double>(cur.root.y) - prev.root.y) /
                               dt;
     if (root_speed >= kFloatMinSpeed && root_speed <= kFloatMaxSpeed) {
       ++float_samples_;
-      if (!near(0, f) && !near(1, f)) ++float_frames_;
+      if (!near(cur, 0) && !near(cur, 1)) ++float_frames_;
     }
-    if (f + 1 < n) {
-      bool pop = false;
-      for (int j = 0; j < kNumLimbJoints && !pop; ++j) {
-        for (int s = 0; s < 2 && !pop; ++s) {
-          const auto& p = t.joint[j][s];
-          const glm::dvec3 d2 =
-              glm::dvec3(p[f + 1]) - 2.0 * glm::dvec3(p[f]) + glm::dvec3(p[f - 1]);
-          const double a = glm::length(d2) / (static_cast<double>(dt) * dt);
-          pop = a > 2.0f * ref_.accel_m_s2[j][s];
-        }
+  }
+  if (f >= 2) {
+    // The acceleration of the previous frame, now that its successor is known.
+    bool pop = false;
+    for (int j = 0; j < kNumLimbJoints && !pop; ++j) {
+      for (int s = 0; s < 2 && !pop; ++s) {
+        const glm::dvec3 d2 = glm::dvec3(cur.joint[j][s]) -
+                              2.0 * glm::dvec3(t.last[1].joint[j][s]) +
+                              glm::dvec3(t.last[0].joint[j][s]);
+        const double a = glm::length(d2) / (static_cast<double>(dt) * dt);
+        pop = a > 2.0f * ref_.accel_m_s2[j][s];
       }
-      if (pop) ++pops_;
+    }
+    if (pop) ++pops_;
+  }
+  // The literature's ratio at 20 fps: toes linearly resampled from the run's frames. Sample k lies
+  // at frame x = k / 20 / dt; those between the previous frame and this one are due now.
+  if (f == 0) {
+    for (int s = 0; s < 2; ++s) t.gmd_prev[s] = glm::dvec3(cur.joint[kToe][s]);
+  } else {
+    const LimbFrame& prev = t.last[1];
+    for (;; ++t.next_gmd) {
+      const double x = t.next_gmd / static_cast<double>(kGmdRateHz) / dt;
+      if (static_cast<int64_t>(x + 1e-9) > f - 1) break;
+      const double u = std::clamp(x - static_cast<double>(f - 1), 0.0, 1.0);
+      glm::dvec3 toe[2];
+      for (int s = 0; s < 2; ++s) {
+        const glm::dvec3 a(prev.joint[kToe][s]);
+        toe[s] = a + (glm::dvec3(cur.joint[kToe][s]) - a) * u;
+      }
+      add_gmd_sample(t, toe);
     }
   }
-  // The literature's ratio at 20 fps: toes linearly resampled from the run's frames.
-  const double span_s = (n - 1) * static_cast<double>(dt);
-  const int m = static_cast<int>(std::floor(span_s * kGmdRateHz + 1e-6)) + 1;
-  auto toe_at = [&](int s, int k) {
-    const double x = k / static_cast<double>(kGmdRateHz) / dt;
-    const size_t i = std::min(static_cast<size_t>(x + 1e-9), n - 1);
-    const size_t i1 = std::min(i + 1, n - 1);
-    const double u = std::clamp(x - static_cast<double>(i), 0.0, 1.0);
-    return glm::dvec3(toe[s][i]) + (glm::dvec3(toe[s][i1]) - glm::dvec3(toe[s][i])) * u;
-  };
-  auto horizontal_d = [](const glm::dvec3& a, const glm::dvec3& b) {
-    return std::hypot(a.x - b.x, a.z - b.z);
-  };
-  glm::dvec3 prev[2] = {toe_at(0, 0), toe_at(1, 0)};
-  for (int k = 1; k < m; ++k) {
-    bool skates = false;
-    for (int s = 0; s < 2; ++s) {
-      const glm::dvec3 cur = toe_at(s, k);
-      const bool contact =
-          cur.y - floor_toe[s] <= kNearFloorM && prev[s].y - floor_toe[s] <= kNearFloorM;
-      if (contact && horizontal_d(cur, prev[s]) * kGmdRateHz > kGmdSkateM_S) skates = true;
-      prev[s] = cur;
+  t.last[0] = t.last[1];
+  t.last[1] = cur;
+  ++t.frames;
+}
+
+void ViewerFeetAccumulator::add_gmd_sample(ViewerTrack& t, const glm::dvec3 toe[2]) {
+  const double floor_toe[2] = {ref_.toe_floor_m[0], ref_.toe_floor_m[1]};
+  bool skates = false;
+  for (int s = 0; s < 2; ++s) {
+    const glm::dvec3& cur = toe[s];
+    const glm::dvec3& prev = t.gmd_prev[s];
+    const bool contact =
+        cur.y - floor_toe[s] <= kNearFloorM && prev.y - floor_toe[s] <= kNearFloorM;
+    if (contact && std::hypot(cur.x - prev.x, cur.z - prev.z) * kGmdRateHz > kGmdSkateM_S) {
+      skates = true;
     }
-    ++gmd_frames_;
-    if (skates) ++gmd_skates_;
+    t.gmd_prev[s] = cur;
   }
+  ++gmd_frames_;
+  if (skates) ++gmd_skates_;
+}
+
+void ViewerFeetAccumulator::end_track(const ViewerTrack& track, float dt) {
+  const int64_t n = track.frames;
+  if (n == 0) return;
+  // The 20 fps samples over the track's span at or after its last frame hold that frame.
+  ViewerTrack t = track;
+  const double span_s = static_cast<double>(n - 1) * static_cast<double>(dt);
+  const int64_t m = static_cast<int64_t>(std::floor(span_s * kGmdRateHz + 1e-6)) + 1;
+  constexpr int kToe = static_cast<int>(LimbJoint::kToe);
+  const glm::dvec3 toe[2] = {glm::dvec3(t.last[1].joint[kToe][0]),
+                             glm::dvec3(t.last[1].joint[kToe][1])};
+  for (; t.next_gmd < m; ++t.next_gmd) add_gmd_sample(t, toe);
+}
+
+void ViewerFeetAccumulator::add_track(const LimbTrack& t, float dt) {
+  ViewerTrack track;
+  for (size_t f = 0; f < t.root.size(); ++f) {
+    LimbFrame frame;
+    for (int j = 0; j < kNumLimbJoints; ++j) {
+      for (int s = 0; s < 2; ++s) frame.joint[j][s] = t.joint[j][s][f];
+    }
+    frame.root = t.root[f];
+    add_frame(track, frame, dt);
+  }
+  end_track(track, dt);
 }
 
 ViewerFeetStats ViewerFeetAccumulator::finish() const {
   ViewerFeetStats r;
   r.agent_frames = agent_frames_;
-  r.support_samples = static_cast<int64_t>(support_cm_s_.size());
-  if (!support_cm_s_.empty()) {
-    double sum = 0.0;
-    for (float v : support_cm_s_) sum += v;
-    r.support_slide_cm_s = sum / support_cm_s_.size();
-    r.support_slide_p95_cm_s = percentile(support_cm_s_, 0.95);
-    r.support_skate_ratio = static_cast<double>(support_skates_) / support_cm_s_.size();
+  const Summary support = support_cm_s_.summary();
+  r.support_samples = static_cast<int64_t>(support.count);
+  if (support.count > 0) {
+    r.support_slide_cm_s = support.mean;
+    r.support_slide_p95_cm_s = support_cm_s_.sketch().floor_rank(0.95);
+    r.support_skate_ratio = static_cast<double>(support_skates_) / support.count;
   }
   r.float_samples = float_samples_;
   if (float_samples_) r.float_ratio = static_cast<double>(float_frames_) / float_samples_;
-  r.penetration_samples = static_cast<int64_t>(depth_cm_.size());
-  if (!depth_cm_.empty()) {
-    r.penetration_p99_cm = percentile(depth_cm_, 0.99);
-    r.penetration_max_cm = *std::max_element(depth_cm_.begin(), depth_cm_.end());
-    r.penetration_ratio = static_cast<double>(deep_) / depth_cm_.size();
+  r.penetration_samples = static_cast<int64_t>(depth_cm_.count());
+  if (r.penetration_samples > 0) {
+    r.penetration_p99_cm = depth_cm_.floor_rank(0.99);
+    r.penetration_max_cm = depth_cm_.max();
+    r.penetration_ratio = static_cast<double>(deep_) / r.penetration_samples;
   }
   r.limb_pops = pops_;
   if (seconds_ > 0.0) r.limb_pop_rate = pops_ / (seconds_ / 60.0);

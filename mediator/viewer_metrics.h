@@ -3,7 +3,7 @@
 // were authored on. The constants below are that document's definitions (a measurement, not a
 // motion parameter: no motion code reads them). One accumulator serves the crowd
 // (MetricsRecorder) and the library's own clips played with their root motion (the floor every
-// figure is reported beside).
+// figure is reported beside), streaming every track frame by frame in fixed memory.
 
 #include <array>
 #include <cstdint>
@@ -11,10 +11,12 @@
 #include <string>
 #include <vector>
 
+#include <glm/ext/vector_double3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "mediator/locomotion_library.h"
+#include "mediator/quantile_sketch.h"
 
 namespace gk {
 
@@ -43,6 +45,22 @@ struct LimbTrack {
   std::span<const glm::vec2> root;                      // pelvis projected on the ground
 };
 
+// One frame of one agent: its limb joints and root.
+struct LimbFrame {
+  glm::vec3 joint[kNumLimbJoints][2];  // [LimbJoint][Side]
+  glm::vec2 root;
+};
+
+// What one agent's track carries from frame to frame: its last two frames (an acceleration needs
+// the frames before and after) and where the 20 fps resampling has got to. A plain value: a
+// default-constructed one starts a track.
+struct ViewerTrack {
+  LimbFrame last[2]{};  // frames n - 2 and n - 1
+  int64_t frames = 0;
+  int64_t next_gmd = 1;      // next 20 fps sample
+  glm::dvec3 gmd_prev[2]{};  // both toes on the last 20 fps sample
+};
+
 struct ViewerFeetStats {
   // Support foot (the lower toe relative to its floor) slide over frame pairs on which it stays
   // the support foot within 5 cm of its floor.
@@ -64,6 +82,9 @@ struct ViewerFeetStats {
   int64_t agent_frames = 0;
 };
 
+// Streams tracks frame by frame in fixed memory: counts, sums and the maximum are exact; the
+// percentiles (support slide p95, penetration p99) come from QuantileSketch, within 0.1% of the
+// exact order statistic (see mediator/quantile_sketch.h).
 class ViewerFeetAccumulator {
  public:
   // METRICS.md v2 definitions:
@@ -76,13 +97,19 @@ class ViewerFeetAccumulator {
   static constexpr float kGmdSkateM_S = 0.5f;
 
   explicit ViewerFeetAccumulator(const FeetReference& reference) : ref_(reference) {}
+  // The next frame of a track (frames dt_s apart; one dt_s for all tracks).
+  void add_frame(ViewerTrack& track, const LimbFrame& frame, float dt_s);
+  // Ends a track: its last 20 fps samples. The track may then start again from ViewerTrack().
+  void end_track(const ViewerTrack& track, float dt_s);
+  // A whole track: add_frame for each frame, then end_track.
   void add_track(const LimbTrack& track, float dt_s);
   ViewerFeetStats finish() const;
 
  private:
+  void add_gmd_sample(ViewerTrack& t, const glm::dvec3 toe[2]);
   FeetReference ref_;
-  std::vector<float> support_cm_s_;
-  std::vector<float> depth_cm_;
+  StreamSummary support_cm_s_;
+  QuantileSketch depth_cm_;
   int64_t support_skates_ = 0;
   int64_t float_frames_ = 0, float_samples_ = 0;
   int64_t deep_ = 0;

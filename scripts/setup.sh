@@ -14,7 +14,7 @@ PACKAGES=(
   libglfw3-dev libimgui-dev libgl-dev libopengl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libgles-dev
   libcli11-dev libtbb-dev librecast-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  xvfb xauth ffmpeg jq
+  xvfb xauth ffmpeg jq gnuplot-nox
   clang libclang-rt-14-dev
 )
 

@@ -176,6 +176,39 @@ TEST(Cli, BenchReplaysRealTrajectories) {
   EXPECT_LT(rep["metrics"]["root_error_cm"]["mean"].get<double>(), 10.0);
 }
 
+TEST(Cli, BenchLoopsAScenarioAndReportsProgress) {
+  // The bottleneck empties through its door; --loop brings a new round in when the last agent has
+  // left. --progress-every prints one JSON line per 300 frames.
+  const CommandResult r =
+      run("bench --scenario bottleneck --agents 20 --frames 3600 --loop --progress-every 300");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::vector<nlohmann::json> lines;
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] == '{') lines.push_back(nlohmann::json::parse(line));
+  }
+  ASSERT_EQ(lines.size(), 12u) << r.out;
+  int rounds = 1;
+  for (size_t k = 0; k < lines.size(); ++k) {
+    const nlohmann::json& j = lines[k];
+    EXPECT_EQ(j["frame"].get<int>(), 300 * static_cast<int>(k + 1));
+    EXPECT_NEAR(j["sim_time_s"].get<double>(), 5.0 * (k + 1), 1e-3);
+    EXPECT_EQ(j["live_tracks"].get<int>(), j["live_agents"].get<int>());
+    EXPECT_GT(j["rss_kib"].get<int64_t>(), 0);
+    EXPECT_GT(j["frame_ms"].get<double>(), 0.0);
+    EXPECT_GE(j["frame_ms_max"].get<double>(), j["frame_ms"].get<double>());
+    EXPECT_GT(j["cpu_ms"].get<double>(), 0.0);
+    EXPECT_GT(j["cpu_us_per_agent_frame"].get<double>(), 0.0);
+    for (const char* what : {"crowd", "poses", "joints"}) {
+      EXPECT_EQ(j["non_finite"][what].get<int64_t>(), 0) << what;
+    }
+    if (k > 0 && j["live_agents"].get<int>() > lines[k - 1]["live_agents"].get<int>()) ++rounds;
+  }
+  EXPECT_GE(rounds, 2) << r.out;
+  // The text report states how far METRICS.md v1's contact band was widened (docs/metrics.md).
+  EXPECT_NE(r.out.find("v1 contact band excess"), std::string::npos) << r.out;
+}
+
 TEST(Cli, BadParametersAreRefusedWithTheirLimits) {
   CommandResult r = run("bench --scenario corridor --frames 10 --set torsion_limit_deg=400");
   EXPECT_EQ(r.code, 2);

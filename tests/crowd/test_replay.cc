@@ -385,5 +385,51 @@ TEST(TrajectoryReplay, SyntheticTracksGapsAndHeadings) {
   EXPECT_EQ(replay->frame().size(), 0u);
 }
 
+TEST(TrajectoryReplay, LoopStartsOverOneStepAfterTheLastSample) {
+  // Ped 1 from 0 to 2.0 s, ped 2 from 0.4 to 1.2 s; one step of 0.4 s after the last sample the
+  // file starts over: period 2.4 s, and each pedestrian is absent in between.
+  const std::string path = write_scratch("loop.txt",
+                                         "0 1 0.0 0.0\n10 1 1.0 0.0\n20 1 2.0 0.0\n"
+                                         "30 1 3.0 0.0\n40 1 4.0 0.0\n50 1 5.0 0.0\n"
+                                         "10 2 0.0 1.0\n20 2 0.0 2.0\n30 2 0.0 3.0\n");
+  ReplayOptions options;
+  options.frame_time_s = 0.4f;
+  options.loop = true;
+  auto loaded = load_trajectory_replay(path, options);
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  CrowdSource& replay = **loaded;
+  constexpr float kDt = 0.05f;
+  constexpr int kPeriodSteps = 48;  // 2.4 s
+  std::vector<std::vector<uint32_t>> ids;
+  std::vector<std::vector<glm::vec2>> positions;
+  for (int k = 0; k < 3 * kPeriodSteps; ++k) {
+    ids.emplace_back(replay.frame().ids.begin(), replay.frame().ids.end());
+    positions.emplace_back(replay.frame().positions.begin(), replay.frame().positions.end());
+    ASSERT_TRUE(replay.step(kDt).ok());
+  }
+  // The third period replays the first (to the rounding of the summed steps).
+  int compared = 0;
+  for (int k = 0; k < kPeriodSteps - 1; ++k) {
+    const int later = k + 2 * kPeriodSteps;
+    ASSERT_EQ(ids[k], ids[later]) << "step " << k;
+    for (size_t i = 0; i < ids[k].size(); ++i) {
+      EXPECT_NEAR(positions[k][i].x, positions[later][i].x, 2e-3f) << "step " << k;
+      EXPECT_NEAR(positions[k][i].y, positions[later][i].y, 2e-3f) << "step " << k;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 50);
+  // Between two lives, a frame with nobody: every id is absent before it comes back.
+  int empty_frames = 0;
+  for (int k = kPeriodSteps / 2; k < 3 * kPeriodSteps; ++k) empty_frames += ids[k].empty();
+  EXPECT_GE(empty_frames, 2 * (0.4f / kDt) - 4);
+  EXPECT_NEAR(replay.time_s(), 3 * kPeriodSteps * kDt, 1e-4);
+  // Without the option the file plays once.
+  auto once = load_trajectory_replay(path, {0.4f});
+  ASSERT_TRUE(once.ok());
+  for (int k = 0; k < 3 * kPeriodSteps; ++k) ASSERT_TRUE((*once)->step(kDt).ok());
+  EXPECT_EQ((*once)->frame().size(), 0u);
+}
+
 }  // namespace
 }  // namespace gk

@@ -71,7 +71,7 @@ inline RunResult run_scripted(const LocomotionLibrary& lib, std::vector<Script> 
   ScriptedCrowd crowd(std::move(scripts), honour);
   Mediator mediator(lib, params, crowd.capacity());
   PoseSynthesizer poses(lib, crowd.capacity(), false);
-  MetricsRecorder metrics(lib, kDt, crowd.capacity(), frames);
+  MetricsRecorder metrics(lib, kDt, crowd.capacity());
   RunResult out;
   for (int f = 0; f < frames; ++f) {
     EXPECT_TRUE(crowd.step(kDt).ok());

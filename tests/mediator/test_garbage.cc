@@ -103,7 +103,7 @@ TEST(Garbage, NothingFromTheSimulatorReachesPalettesPlansOrFeedback) {
   GarbageCrowd crowd;
   Mediator mediator(lib, MediatorParams{}, GarbageCrowd::kAgents);
   PoseSynthesizer poses(lib, GarbageCrowd::kAgents, /*make_palettes=*/true);
-  MetricsRecorder metrics(lib, kDt, GarbageCrowd::kAgents, 300);
+  MetricsRecorder metrics(lib, kDt, GarbageCrowd::kAgents);
   int bad_palette = 0, bad_plan = 0, bad_feedback = 0;
   for (int f = 0; f < 300; ++f) {
     const AgentFrame frame = crowd.frame();

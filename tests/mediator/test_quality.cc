@@ -25,7 +25,7 @@ MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, Media
   params.mode = mode;
   Mediator mediator(lib, params, crowd.capacity());
   PoseSynthesizer poses(lib, crowd.capacity(), false);
-  MetricsRecorder metrics(lib, kDt, crowd.capacity(), kFrames);
+  MetricsRecorder metrics(lib, kDt, crowd.capacity());
   for (int f = 0; f < kFrames; ++f) {
     EXPECT_TRUE(crowd.step(kDt).ok());
     const AgentFrame frame = crowd.frame();

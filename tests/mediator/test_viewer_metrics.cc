@@ -74,6 +74,7 @@ TEST(ViewerMetrics, SupportFootCreepAndSkate) {
   // Speeds 6, 6, 60, 60: mean 33, p95 the 4th of 4 (nearest rank) = 60, 2 of 4 above 30.
   ASSERT_EQ(s.support_samples, 4);
   EXPECT_NEAR(s.support_slide_cm_s, 33.0, 1e-3);
+  // The largest sample: the sketch returns the exact maximum.
   EXPECT_NEAR(s.support_slide_p95_cm_s, 60.0, 1e-3);
   EXPECT_DOUBLE_EQ(s.support_skate_ratio, 0.5);
 }
@@ -143,7 +144,8 @@ TEST(ViewerMetrics, PenetrationIsTheDeeperOfToeAndAnkleBelowTheirFloors) {
   const ViewerFeetStats s = measure({t});
   EXPECT_EQ(s.penetration_samples, 120);
   EXPECT_NEAR(s.penetration_max_cm, 3.0, 1e-4);
-  EXPECT_NEAR(s.penetration_p99_cm, 2.0, 1e-4);
+  // A percentile comes from the quantile sketch: within its documented relative error.
+  EXPECT_NEAR(s.penetration_p99_cm, 2.0, 2.0 * QuantileSketch::kRelativeError + 1e-6);
   EXPECT_NEAR(s.penetration_ratio, 2.0 / 120.0, 1e-12);
 }
 
