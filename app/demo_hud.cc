@@ -38,13 +38,15 @@ void DemoApp::draw_overlay_text() {
   const float base = ImGui::GetFontSize();
   char text[160];
   if (split) {
-    const std::string_view right = mediator_mode_name(session_->params().mode);
+    const std::string_view right =
+        lesson_ ? lesson_->on_label : mediator_mode_name(session_->params().mode);
     std::snprintf(text, sizeof(text), "%.*s", static_cast<int>(right.size()), right.data());
-    boxed_text(fg, ImVec2(12, 10), "naive", base * 1.4f, kWhite);
+    boxed_text(fg, ImVec2(12, 10), lesson_ ? lesson_->off_label : "naive", base * 1.4f, kWhite);
     boxed_text(fg, ImVec2(half + 12, 10), text, base * 1.4f, kWhite);
     fg->AddLine(ImVec2(half, 0), ImVec2(half, static_cast<float>(view.y)),
                 IM_COL32(20, 20, 20, 255), 2.0f);
   }
+  draw_lesson_text(split ? base * 3.2f : 12.0f);
   // Frames per second and whether the simulation keeps real time, bottom left of the view.
   const float bottom = static_cast<float>(view.y) - base - 10.0f;
   if (fps_ > 0.0f) {
@@ -60,6 +62,11 @@ void DemoApp::draw_overlay_text() {
                   "cannot keep up", clock_.achieved_rate(), time_scale_);
     boxed_text(fg, ImVec2(12, bottom - base * 1.8f), text, base * 1.2f,
                IM_COL32(255, 170, 60, 255));
+  } else if (scrubbing()) {
+    std::snprintf(text, sizeof(text), "recorded %.2f s (live %.2f s)",
+                  recorder_->time_s(scrub_), session_->crowd().time_s());
+    boxed_text(fg, ImVec2(12, bottom - base * 1.8f), text, base * 1.2f,
+               IM_COL32(120, 200, 255, 255));
   } else if (paused_) {
     boxed_text(fg, ImVec2(12, bottom - base * 1.8f), "paused (Space)", base * 1.2f,
                IM_COL32(255, 220, 90, 255));
