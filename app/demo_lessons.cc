@@ -148,8 +148,9 @@ void DemoApp::panel_gait() {
     return;
   }
   const GaitSample& last = gait_[0][(gait_count_ - 1) % kGaitSamples];
-  ImGui::Text("stride %.2f m (clip %.2f)  cadence %.0f (clip %.0f) steps/min", last.stride_m,
-              native_stride_m_, last.cadence_spm, native_cadence_spm_);
+  ImGui::Text("stride %.2f m (clip %.2f)  speed %.2f m/s (clip %.2f)", last.stride_m,
+              native_stride_m_, last.speed_m_s, native_speed_m_s_);
+  ImGui::Text("cadence %.0f steps/min (clip %.0f)", last.cadence_spm, native_cadence_spm_);
   const bool two = session_->has_compare();
   // Two scatter plots against speed: dots of the last 4 s, the clip's own value as a cross.
   const ImVec2 size(ImGui::GetContentRegionAvail().x * 0.5f - 4.0f, 90.0f);

@@ -24,19 +24,19 @@ void no_twist(MediatorParams* p) { p->torsion_limit_deg = 0.0f; }
 void no_feedback(MediatorParams* p) { p->feedback = false; }
 
 const Lesson kLessons[] = {
-    {"foot-sliding", "Foot sliding", "crossing", 24, 1, 0.5f, true, 200.0f, 6.0f,
+    {"foot-sliding", "Foot sliding", "bottleneck", 0, 1, 0.5f, true, 180.0f, 7.0f,
      overlays(true, false, false, false, false), "naive", "apm", naive, keep, false, false,
      "Left, naive animation: one clip at its own speed while the simulator moves the body at "
      "another, so feet smear over the ground (red trails). Right, the mediator: every planted "
      "foot leaves a still, green footprint. Watch the followed agent's feet at half speed.",
      "FOOT SLIDING - RED TRAILS: FEET SKATE. GREEN: FEET STAND STILL"},
-    {"playback-rate", "Playback-rate matching", "crossing", 24, 1, 0.5f, true, 200.0f, 6.0f,
+    {"playback-rate", "Playback-rate matching", "crossing", 24, 1, 0.5f, true, 110.0f, 7.0f,
      overlays(true, false, false, false, false), "naive", "rate", naive, rate_only, false, true,
      "Left, naive: the clip plays at its native rate whatever the agent's speed. Right, rate "
      "matching only: the clip plays faster or slower so its stride speed equals the walking "
      "speed. The panel plots the selected agent's stride length and cadence against its speed "
      "beside the clip's own values; most sliding goes, except in turns and speed changes.",
-     "RATE MATCHING - PLAYBACK RATE = SPEED / CLIP SPEED"},
+     "RATE MATCHING - CLIP PLAYED AT AGENT SPEED / CLIP SPEED"},
     {"foot-locking", "Foot locking", "crossing", 12, 1, 0.5f, true, 200.0f, 5.0f,
      overlays(true, true, false, false, false), "locking off", "locking on", no_locking, keep,
      false, false,
