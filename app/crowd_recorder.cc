@@ -15,13 +15,14 @@ CrowdRecorder::CrowdRecorder(size_t capacity, int joints, int lanes)
   num_posed_.assign(slots, 0);
   states_.assign(slots * capacity_, AgentState{});
   posed_ids_.assign(slots * posed_cap_, -1);
-  rows_.assign(slots * posed_cap_ * static_cast<size_t>(joints_) * 3, glm::vec4(0.0f));
+  num_rows_ = slots * posed_cap_ * static_cast<size_t>(joints_) * 3;
+  rows_.reset(new glm::vec4[num_rows_]);  // only records written are read back
 }
 
 size_t CrowdRecorder::bytes() const {
   return time_s_.size() * sizeof(double) + num_agents_.size() * sizeof(uint32_t) * 2 +
          states_.size() * sizeof(AgentState) + posed_ids_.size() * sizeof(int64_t) +
-         rows_.size() * sizeof(glm::vec4);
+         num_rows_ * sizeof(glm::vec4);
 }
 
 void CrowdRecorder::record(const CrowdSession& session, int64_t selected_id) {

@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -69,7 +70,10 @@ class CrowdRecorder {
   std::vector<uint32_t> num_posed_;            // [frame * lanes + lane]
   std::vector<AgentState> states_;             // [(frame * lanes + lane) * capacity + i]
   std::vector<int64_t> posed_ids_;             // [(frame * lanes + lane) * posed_cap + j]
-  std::vector<glm::vec4> rows_;                // [((f * lanes + l) * posed_cap + j) * J * 3 + r]
+  // [((f * lanes + l) * posed_cap + j) * J * 3 + r]; not zero-filled, so its pages become
+  // resident as the minute fills rather than all at creation.
+  std::unique_ptr<glm::vec4[]> rows_;
+  size_t num_rows_ = 0;
 };
 
 }  // namespace gk::app
