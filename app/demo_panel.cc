@@ -243,8 +243,10 @@ void DemoApp::panel_metrics() {
     const auto series = static_cast<LiveSeries>(s);
     char overlay[64];
     if (session_->has_compare() && compare_metrics_.count() > 0) {
-      std::snprintf(overlay, sizeof(overlay), "%.2f %s (naive %.2f)", metrics_.mean(series),
-                    LiveMetrics::unit(series), compare_metrics_.mean(series));
+      // The left half's figure, named as the split names it.
+      std::snprintf(overlay, sizeof(overlay), "%.2f %s (%s %.2f)", metrics_.mean(series),
+                    LiveMetrics::unit(series), lesson_ ? lesson_->off_label : "naive",
+                    compare_metrics_.mean(series));
     } else {
       std::snprintf(overlay, sizeof(overlay), "%.2f %s (5 s mean)", metrics_.mean(series),
                     LiveMetrics::unit(series));
