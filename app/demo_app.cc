@@ -338,6 +338,8 @@ void DemoApp::write_report(const std::string& path) const {
       {"lessons_menu",
        {lessons_menu_rect_.x, lessons_menu_rect_.y, lessons_menu_rect_.z, lessons_menu_rect_.w}},
       {"lesson_items", lesson_items},
+      {"lesson_text",
+       {lesson_text_rect_.x, lesson_text_rect_.y, lesson_text_rect_.z, lesson_text_rect_.w}},
       {"scenario", session_->setup().scenario_name},
       {"agent_count", session_->setup().agents},
       {"frames", frames_drawn_},

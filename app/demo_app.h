@@ -86,7 +86,7 @@ class DemoApp {
   void enable_split();  // the lesson's split, or naive | the chosen mode
   void record_gait();   // the selected agent's stride and cadence, both lanes
   void panel_gait();    // their plot against speed
-  void draw_lesson_text(float top_px);
+  void draw_lesson_text(float bottom_px);
   void lessons_menu();
   // app/demo_timeline.cc: the last minute kept in a CrowdRecorder, scrubbed from the panel.
   void reset_recorder();
@@ -168,7 +168,8 @@ class DemoApp {
   std::vector<int64_t> replay_ids_[2];
   const Lesson* lesson_ = nullptr;
   bool pick_lesson_agent_ = false;  // follow the lesson's agent once the crowd has a frame
-  glm::vec4 lessons_menu_rect_{0.0f};  // x, y, w, h [px] of the Lessons menu header
+  glm::vec4 lessons_menu_rect_{0.0f};
+  glm::vec4 lesson_text_rect_{0.0f};  // x, y, w, h [px] of the lesson's text box  // x, y, w, h [px] of the Lessons menu header
   std::vector<glm::vec4> lesson_item_rects_;  // the menu's items while it is open (tests)
   // The selected agent's gait, per lane (0 primary, 1 compare): speed [m/s], stride length [m]
   // (one gait cycle), cadence [steps/min]; a ring of the last kGaitSamples frames.

@@ -46,7 +46,6 @@ void DemoApp::draw_overlay_text() {
     fg->AddLine(ImVec2(half, 0), ImVec2(half, static_cast<float>(view.y)),
                 IM_COL32(20, 20, 20, 255), 2.0f);
   }
-  draw_lesson_text(split ? base * 3.2f : 12.0f);
   // Frames per second and whether the simulation keeps real time, bottom left of the view.
   const float bottom = static_cast<float>(view.y) - base - 10.0f;
   if (fps_ > 0.0f) {
@@ -57,6 +56,7 @@ void DemoApp::draw_overlay_text() {
                   SimClock::step_s(time_scale_) * 1000.0);
   }
   boxed_text(fg, ImVec2(12, bottom), text, base, IM_COL32(220, 220, 220, 255));
+  draw_lesson_text(bottom - base * 2.6f);
   if (clock_.behind() && !paused_) {
     std::snprintf(text, sizeof(text), "simulation at %.2fx real time (asked %.2fx): this machine "
                   "cannot keep up", clock_.achieved_rate(), time_scale_);

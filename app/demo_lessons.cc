@@ -75,7 +75,8 @@ void DemoApp::lessons_menu() {
   ImGui::EndMenuBar();
 }
 
-void DemoApp::draw_lesson_text(float top_px) {
+void DemoApp::draw_lesson_text(float bottom_px) {
+  lesson_text_rect_ = glm::vec4(0.0f);
   if (!lesson_) return;
   ImDrawList* fg = ImGui::GetForegroundDrawList();
   const glm::ivec2 scene = scene_size();
@@ -84,10 +85,12 @@ void DemoApp::draw_lesson_text(float top_px) {
   ImFont* font = ImGui::GetFont();
   const ImVec2 title = font->CalcTextSizeA(base * 1.2f, 1e9f, wrap, lesson_->title);
   const ImVec2 body = font->CalcTextSizeA(base, 1e9f, wrap, lesson_->text);
-  const ImVec2 at(20.0f, top_px);
-  fg->AddRectFilled(ImVec2(at.x - 6, at.y - 4),
-                    ImVec2(at.x + std::max(title.x, body.x) + 6, at.y + title.y + body.y + 8),
-                    IM_COL32(0, 0, 0, 170), 4.0f);
+  // Along the bottom of the scene: the followed agent's head and its labels are above the middle.
+  const ImVec2 at(20.0f, bottom_px - title.y - body.y - 8.0f);
+  const ImVec2 lo(at.x - 6, at.y - 4);
+  const ImVec2 hi(at.x + std::max(title.x, body.x) + 6, at.y + title.y + body.y + 8);
+  lesson_text_rect_ = glm::vec4(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
+  fg->AddRectFilled(lo, hi, IM_COL32(0, 0, 0, 170), 4.0f);
   fg->AddText(font, base * 1.2f, at, IM_COL32(255, 220, 120, 255), lesson_->title);
   fg->AddText(font, base, ImVec2(at.x, at.y + title.y + 4), IM_COL32(240, 240, 240, 255),
               lesson_->text, nullptr, wrap);

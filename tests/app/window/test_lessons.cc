@@ -66,12 +66,19 @@ TEST(DemoLessons, TheMenuSwitchesToALessonAndItsSplit) {
   EXPECT_TRUE(s.report["overlays"]["trails"].get<bool>());
   EXPECT_NEAR(s.report["time_scale"].get<double>(), 0.5, 1e-6);
   EXPECT_TRUE(s.report["following"].get<bool>());
-  // The lesson's text sits in a dark box under the halves' labels; before the switch the same
-  // place showed the gallery.
+  // The lesson's text sits in a dark box along the bottom of the scene; before the switch the
+  // same place showed the gallery.
+  const auto& box = s.report["lesson_text"];
+  const int x0 = static_cast<int>(box[0].get<double>()), y0 = static_cast<int>(box[1].get<double>());
+  const int x1 = x0 + static_cast<int>(box[2].get<double>());
+  const int y1 = y0 + static_cast<int>(box[3].get<double>());
+  ASSERT_GT(x1 - x0, 300) << box;
+  ASSERT_GT(y1 - y0, 40) << box;
+  EXPECT_LE(x1, s.report["scene_width"].get<int>());
   int bright = 0, bright_before = 0;
   float mean = 0.0f, mean_before = 0.0f;
-  text_box_stats(s.image, 24, 50, 420, 110, &bright, &mean);
-  text_box_stats(closed.image, 24, 50, 420, 110, &bright_before, &mean_before);
+  text_box_stats(s.image, x0, y0, x1, y1, &bright, &mean);
+  text_box_stats(closed.image, x0, y0, x1, y1, &bright_before, &mean_before);
   EXPECT_GT(bright, 300) << "no text over the scene";
   EXPECT_LT(mean, 90.0f) << "no dark box behind the text";
   EXPECT_GT(mean_before, mean + 40.0f);
