@@ -27,6 +27,9 @@ void add_demo_command(CLI::App& app) {
   cmd->add_option("--overlay", options->overlays,
                   "Overlays on at start: velocity, theta, facing, planted, trails, paths, torso "
                   "(the selected agent's torso fan), all (default: torso; the showcase: trails)");
+  cmd->add_option("--lesson", options->lesson,
+                  "Open on a lesson: " + lesson_names() +
+                      " (scenario, camera, speed, overlays and a split of that one idea off | on)");
   cmd->add_option("--select", options->select, "Agent id to select and follow from the start");
   cmd->add_option("--pull-out", options->pull_out,
                   "With --select: at this simulated time [s] the camera pulls out to the whole "

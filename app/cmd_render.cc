@@ -19,6 +19,7 @@
 #include "app/camera_director.h"
 #include "app/commands.h"
 #include "app/crowd_session.h"
+#include "app/lessons.h"
 #include "app/offscreen.h"
 #include "app/overlays.h"
 #include "common/file_io.h"
@@ -41,7 +42,14 @@ struct RenderOptions {
   std::string follow;
   std::string pull_out;
   std::string report;
+  std::string lesson;
 };
+
+std::string upper(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return out;
+}
 
 enum class OutputKind { kPng, kVideo, kFolder };
 
@@ -95,7 +103,8 @@ void stamp_twist(const CrowdSession& s, const AnimationLane& lane, int64_t id,
 // Last frame's agents: ids, ground positions and where their hips (0.9 m up) land in the image,
 // so tests can look at the right pixels.
 void write_report(const std::string& path, const CrowdSession& s, const OrbitCamera& camera,
-                  glm::ivec2 size, bool split, const Exhibits& exhibits, int64_t follow) {
+                  glm::ivec2 size, bool split, const Exhibits& exhibits, int64_t follow,
+                  const Lesson* lesson) {
   nlohmann::json agents = nlohmann::json::array();
   const glm::ivec2 view = split ? glm::ivec2(size.x / 2, size.y) : size;
   const auto draws = s.lane().draw_span();
@@ -123,7 +132,15 @@ void write_report(const std::string& path, const CrowdSession& s, const OrbitCam
                         {"distance_m", camera.distance_m},
                         {"fov_y_deg", camera.fov_y_deg}}},
                       {"agents", agents},
-                      {"exhibits", shown}};
+                      {"exhibits", shown},
+                      {"follow_id", follow},
+                      {"lesson", lesson ? lesson->name : ""}};
+  if (split && s.has_compare()) {
+    j["compare_params"] =
+        nlohmann::json::parse(mediator_params_to_json(s.compare_lane().mediator->params()));
+    j["compare_own_crowd"] = s.compare_has_own_crowd();
+  }
+  j["params"] = nlohmann::json::parse(mediator_params_to_json(s.params()));
   if (const std::optional<TorsoReadout> t = torso_readout(s, s.lane(), follow)) {
     const ProjectedPoint head = camera.project(t->head, view);
     j["followed"] = {{"id", follow},
@@ -140,6 +157,22 @@ void write_report(const std::string& path, const CrowdSession& s, const OrbitCam
 
 void run_render(RenderOptions& o) {
   o.crowd.command = kCmd;
+  const Lesson* lesson = nullptr;
+  if (!o.lesson.empty()) {
+    lesson = find_lesson(o.lesson);
+    if (!lesson) fail(kCmd, 2, "--lesson: expected " + lesson_names() + ", got '" + o.lesson + "'");
+    if (!o.crowd.scenario.empty()) fail(kCmd, 2, "--lesson sets the scenario: drop --scenario");
+    o.crowd.scenario = lesson->scenario;
+    if (o.crowd.agents.empty() && lesson->agents > 0) o.crowd.agents = std::to_string(lesson->agents);
+    o.compare = true;
+    const OverlayToggles& t = lesson->overlays;
+    const std::pair<bool, const char*> on[] = {{t.velocity, "velocity"}, {t.theta, "theta"},
+                                               {t.planted, "planted"},   {t.trails, "trails"},
+                                               {t.torso, "torso"}};
+    for (const auto& [set, name] : on) {
+      if (set) o.overlays.emplace_back(name);
+    }
+  }
   if (o.crowd.scenario.empty()) o.crowd.scenario = "crossing";
   const int frames = parse_number<int>(kCmd, o.frames, "--frames", 1, 1'000'000);
   OutputKind kind = OutputKind::kFolder;
@@ -148,15 +181,17 @@ void run_render(RenderOptions& o) {
   else if (ends_with(o.out, ".mp4"))
     kind = OutputKind::kVideo;
   const OverlayToggles overlays = parse_overlays(o.overlays);
-  const int64_t follow =
+  int64_t follow =
       o.follow.empty() ? -1 : parse_number<int>(kCmd, o.follow, "--follow", 0, 1 << 30);
-  if (overlays.torso && follow < 0 && o.overlays.end() != std::find(o.overlays.begin(),
-                                                                       o.overlays.end(), "torso")) {
+  // A lesson follows the agent nearest the scene's middle once the crowd has its first frame.
+  bool pick_follow = lesson && lesson->follow && follow < 0;
+  if (overlays.torso && follow < 0 && !pick_follow &&
+      o.overlays.end() != std::find(o.overlays.begin(), o.overlays.end(), "torso")) {
     fail(kCmd, 2, "--overlay torso draws the followed agent's torso fan: add --follow ID");
   }
   const double pull_out_s =
       o.pull_out.empty() ? -1.0 : parse_number<float>(kCmd, o.pull_out, "--pull-out", 0.0f, 1e6f);
-  if (pull_out_s >= 0.0 && follow < 0) {
+  if (pull_out_s >= 0.0 && follow < 0 && !pick_follow) {
     fail(kCmd, 2, "--pull-out: pulls out from a followed agent: add --follow ID");
   }
   // Output paths are checked before the work starts, not after seconds of simulation.
@@ -173,7 +208,14 @@ void run_render(RenderOptions& o) {
     std::filesystem::create_directories(o.out, ec);
     if (ec) fail(kCmd, 1, o.out + ": cannot create the folder: " + ec.message());
   }
-  if (o.compare) session->enable_compare(MediatorMode::kNaive);
+  if (lesson) {
+    MediatorParams p = session->params();
+    lesson->on(&p);
+    session->set_params(p);
+    session->enable_compare(lesson->off, lesson->own_crowd);
+  } else if (o.compare) {
+    session->enable_compare(MediatorMode::kNaive);
+  }
   OffscreenScene scene = open_offscreen_scene(kCmd, *session, o.size);
   if (o.compare) {
     // Each half is its own, narrower view of the whole scene.
@@ -184,10 +226,16 @@ void run_render(RenderOptions& o) {
   // With --follow the camera rides on the agent: --camera then sets its angles and distance.
   CameraDirector director;
   director.set_overview(scene.view->camera());
-  if (follow >= 0) {
+  if (lesson) {
+    OrbitCamera overview = director.overview();
+    overview.yaw_rad = glm::radians(lesson->yaw_deg);
+    director.set_overview(overview);
+    scene.view->camera().yaw_rad = overview.yaw_rad;
+  }
+  auto start_following = [&] {
     OrbitCamera& c = scene.view->camera();
     c.pitch_rad = kFollowPitch_rad;
-    c.distance_m = kFollowDistance_m;
+    c.distance_m = lesson ? lesson->distance_m : kFollowDistance_m;
     if (!o.camera.empty()) {
       apply_camera(o.camera, &c);
       // The pull-out ends on the whole scene seen from the same side.
@@ -198,6 +246,9 @@ void run_render(RenderOptions& o) {
     director.follow(follow, c.distance_m, c.pitch_rad);
     director.snap();
     if (pull_out_s >= 0.0) director.pull_out_at(pull_out_s);
+  };
+  if (follow >= 0) {
+    start_following();
   } else if (!o.camera.empty()) {
     apply_camera(o.camera, &scene.view->camera());
   }
@@ -222,15 +273,16 @@ void run_render(RenderOptions& o) {
   }
 
   std::optional<OverlayHistory> history, compare_history;
-  if (overlays.any() || follow >= 0) {
+  if (overlays.any() || follow >= 0 || pick_follow) {
     history.emplace(*session, session->crowd().capacity());
     if (o.compare) compare_history.emplace(*session, session->crowd().capacity());
   }
   const bool split = o.compare;
   FrameCapture capture;
   const int label_scale = std::max(2, size.y / 240);
-  std::string right_label(mediator_mode_name(session->params().mode));
-  for (char& c : right_label) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const std::string left_label = lesson ? upper(lesson->off_label) : "NAIVE";
+  const std::string right_label =
+      upper(lesson ? lesson->on_label : mediator_mode_name(session->params().mode));
   const bool tty = isatty(fileno(stderr)) != 0;
   for (int f = 0; f < frames; ++f) {
     if (Status s = session->step(kFrameTime_s); !s.ok()) {
@@ -239,6 +291,12 @@ void run_render(RenderOptions& o) {
     }
     if (history) history->record(*session, session->lane(), kFrameTime_s);
     if (compare_history) compare_history->record(*session, session->compare_lane(), kFrameTime_s);
+    if (pick_follow && session->frame().size() > 0) {
+      pick_follow = false;
+      follow = agent_nearest(session->frame(),
+                             0.5f * (session->bounds_min() + session->bounds_max()));
+      start_following();
+    }
     const bool needed = kind != OutputKind::kPng || f == frames - 1;
     if (!needed && follow < 0) continue;
     session->collect();  // also the followed agent's drawn position
@@ -279,7 +337,7 @@ void run_render(RenderOptions& o) {
       }
     }
     if (split) {
-      stamp_label(capture.mutable_rgba(), size, {8 * label_scale, 8 * label_scale}, "NAIVE",
+      stamp_label(capture.mutable_rgba(), size, {8 * label_scale, 8 * label_scale}, left_label,
                   label_scale);
       stamp_label(capture.mutable_rgba(), size, {size.x / 2 + 8 * label_scale, 8 * label_scale},
                   right_label, label_scale);
@@ -290,6 +348,12 @@ void run_render(RenderOptions& o) {
           p[0] = p[1] = p[2] = 20;
         }
       }
+    }
+    if (lesson) {
+      // What to look at, along the bottom edge (the window shows the whole text).
+      const int scale = std::max(1, label_scale - 1);
+      stamp_label(capture.mutable_rgba(), size, {8 * scale, size.y - 14 * scale},
+                  lesson->caption, scale, {255, 220, 120});
     }
     Status written;
     if (kind == OutputKind::kVideo) {
@@ -322,12 +386,13 @@ void run_render(RenderOptions& o) {
       fail(kCmd, 1, "ffmpeg failed writing " + o.out + " (exit " + std::to_string(status) + ")");
   }
   if (!o.report.empty()) {
-    write_report(o.report, *session, scene.view->camera(), size, split, exhibits, follow);
+    write_report(o.report, *session, scene.view->camera(), size, split, exhibits, follow, lesson);
   }
-  std::printf("render: %d frames of %s (%d agents, %s%s) written to %s\n", frames,
+  std::printf("render: %d frames of %s (%d agents, %s%s%s) written to %s\n", frames,
               session->setup().scenario_name.c_str(), static_cast<int>(session->frame().size()),
               std::string(mediator_mode_name(session->params().mode)).c_str(),
-              split ? ", left naive" : "", o.out.c_str());
+              split ? ", left " : "", split ? (lesson ? lesson->off_label : "naive") : "",
+              o.out.c_str());
 }
 
 }  // namespace
@@ -357,6 +422,10 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--pull-out", options->pull_out,
                   "With --follow: at this simulated time [s] the camera pulls out to the whole "
                   "scene");
+  cmd->add_option("--lesson", options->lesson,
+                  "A lesson's scene: " + lesson_names() +
+                      " (scenario, follow camera, overlays, split of that one idea off | on, the "
+                      "caption)");
   cmd->add_option("--report", options->report,
                   "Write the last frame's agent positions and image pixels as JSON");
   cmd->callback([options] { run_render(*options); });

@@ -44,6 +44,9 @@ std::unique_ptr<CrowdSession> CrowdSession::create(const CrowdOptions& o) {
       parse_number<uint64_t>(o.command, o.seed, "--seed", 0, std::numeric_limits<uint64_t>::max());
   std::unique_ptr<CrowdSession> s(new CrowdSession());
   s->setup_ = make_crowd(o, threads, seed);
+  s->options_ = o;
+  s->threads_ = threads;
+  s->seed_ = seed;
   s->library_ = std::make_unique<LocomotionLibrary>(load_library(o));
   s->params_ = make_params(o, seed);
   // The mediator and pose passes run on TBB: cap its workers at --threads (0 = all cores).
@@ -87,9 +90,18 @@ AnimationLane CrowdSession::make_lane(const MediatorParams& params) const {
 }
 
 void CrowdSession::enable_compare(MediatorMode mode) {
+  enable_compare([mode](MediatorParams* p) { p->mode = mode; });
+}
+
+void CrowdSession::enable_compare(std::function<void(MediatorParams*)> adjust, bool own_crowd) {
+  compare_adjust_ = std::move(adjust);
   MediatorParams p = params_;
-  p.mode = mode;
+  if (compare_adjust_) compare_adjust_(&p);
   compare_ = make_lane(p);
+  compare_crowd_.reset();
+  if (own_crowd) {
+    compare_crowd_.emplace(make_crowd(options_, threads_, seed_));
+  }
 }
 
 void CrowdSession::set_params(const MediatorParams& params) {
@@ -97,7 +109,7 @@ void CrowdSession::set_params(const MediatorParams& params) {
   primary_.mediator->set_params(params);
   if (compare_) {
     MediatorParams p = params;
-    p.mode = compare_->mediator->params().mode;
+    if (compare_adjust_) compare_adjust_(&p);
     compare_->mediator->set_params(p);
   }
 }
@@ -112,7 +124,16 @@ Status CrowdSession::step(double dt_s) {
   t = Clock::now();
   GK_RETURN_IF_ERROR(primary_.mediator->plan(frame_, dt, crowd.feedback_policy()));
   GK_RETURN_IF_ERROR(crowd.apply_feedback(primary_.mediator->feedback().view(frame_.size())));
-  if (compare_) GK_RETURN_IF_ERROR(compare_->mediator->plan(frame_, dt, crowd.feedback_policy()));
+  if (compare_crowd_) {
+    CrowdSource& own = *compare_crowd_->crowd;
+    GK_RETURN_IF_ERROR(own.step(dt));
+    compare_frame_ = own.frame();
+    GK_RETURN_IF_ERROR(compare_->mediator->plan(compare_frame_, dt, own.feedback_policy()));
+    GK_RETURN_IF_ERROR(
+        own.apply_feedback(compare_->mediator->feedback().view(compare_frame_.size())));
+  } else if (compare_) {
+    GK_RETURN_IF_ERROR(compare_->mediator->plan(frame_, dt, crowd.feedback_policy()));
+  }
   times_.mediator_ms = ms_since(t);
   t = Clock::now();
   primary_.poses->run(*primary_.mediator, dt);
@@ -124,14 +145,15 @@ Status CrowdSession::step(double dt_s) {
 
 void CrowdSession::collect_lane(AnimationLane* lane) const {
   const AnimationPlans& plans = lane->mediator->plans();
-  const size_t n = std::min(frame_.size(), capacity_);
+  const AgentFrame& frame = frame_of(*lane);
+  const size_t n = std::min(frame.size(), capacity_);
   const size_t J = static_cast<size_t>(num_joints_);
   for (size_t i = 0; i < n; ++i) {
     const int slot = plans.slot_of_agent[i];
     const auto palette = lane->poses->palette(slot);
     std::copy(palette.begin(), palette.end(), lane->palettes.begin() + i * J);
     const glm::vec2 root = plans.root_xz[slot];
-    lane->draws[i] = AgentDraw{glm::vec3(root.x, 0.0f, root.y), agent_tint(frame_.ids[i]), 0};
+    lane->draws[i] = AgentDraw{glm::vec3(root.x, 0.0f, root.y), agent_tint(frame.ids[i]), 0};
   }
   lane->num_collected = n;
 }

@@ -9,6 +9,7 @@
 // crowd. Everything per frame is sized at creation: step() and collect() allocate nothing.
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -56,7 +57,13 @@ class CrowdSession {
 
   // Adds (or replaces) the compare lane with its own mode; the other parameters are the primary's.
   void enable_compare(MediatorMode mode);
-  void disable_compare() { compare_.reset(); }
+  // The compare lane with the primary's parameters changed by `adjust` (the mode, or one idea
+  // switched off: `foot_locking`, `feedback`, ...), also after every set_params. With `own_crowd`
+  // the lane drives its own copy of the crowd (same options and seed, from the start: call it
+  // before the first step) and feeds back to it: for ideas that change the simulation itself
+  // (feedback), which the primary's crowd cannot show.
+  void enable_compare(std::function<void(MediatorParams*)> adjust, bool own_crowd = false);
+  void disable_compare() { compare_.reset(), compare_crowd_.reset(), compare_adjust_ = nullptr; }
   bool has_compare() const { return compare_.has_value(); }
 
   Status step(double dt_s);
@@ -64,11 +71,17 @@ class CrowdSession {
   void collect();
 
   const AgentFrame& frame() const { return frame_; }
+  // The crowd frame a lane animates: the primary's, or the compare lane's own crowd's.
+  const AgentFrame& frame_of(const AnimationLane& lane) const {
+    return compare_crowd_ && compare_ && &lane == &*compare_ ? compare_frame_ : frame_;
+  }
+  bool compare_has_own_crowd() const { return compare_crowd_.has_value(); }
   const AnimationLane& lane() const { return primary_; }
   const AnimationLane& compare_lane() const { return *compare_; }
   const Mediator& mediator() const { return *primary_.mediator; }
   const PoseSynthesizer& poses() const { return *primary_.poses; }
   CrowdSource& crowd() { return *setup_.crowd; }
+  double crowd_time_s() const { return setup_.crowd->time_s(); }
   const CrowdSetup& setup() const { return setup_; }
   const LocomotionLibrary& library() const { return *library_; }
   const SkinnedMesh& mesh() const { return *mesh_; }
@@ -91,6 +104,12 @@ class CrowdSession {
   void collect_lane(AnimationLane* lane) const;
 
   CrowdSetup setup_;
+  CrowdOptions options_;  // to build the compare lane's own crowd
+  int threads_ = 1;
+  uint64_t seed_ = 1;
+  std::optional<CrowdSetup> compare_crowd_;
+  AgentFrame compare_frame_;
+  std::function<void(MediatorParams*)> compare_adjust_;
   std::unique_ptr<LocomotionLibrary> library_;  // stable address: the mediators refer to it
   std::shared_ptr<const SkinnedMesh> mesh_;
   std::optional<tbb::global_control> thread_cap_;

@@ -35,6 +35,7 @@ constexpr float kStepBudget_ms = 40.0f;
 DemoApp::DemoApp(DemoOptions options) : options_(std::move(options)) {
   crowd_ = options_.crowd;
   crowd_.command = "demo";
+  if (const Lesson* l = find_lesson(options_.lesson)) crowd_.scenario = l->scenario;
   showcase_ = crowd_.scenario.empty();
   if (showcase_) {
     // The point at a glance: feet at a crowded door, naive beside apm, trails on the ground.
@@ -84,10 +85,11 @@ bool DemoApp::rebuild() {
     return false;
   }
   status_.clear();
-  if (compare_) session_->enable_compare(MediatorMode::kNaive);
   const size_t capacity = session_->crowd().capacity();
   history_.emplace(*session_, capacity);
   compare_history_.emplace(*session_, capacity);
+  if (compare_) enable_split();
+  reset_recorder();
   metrics_.reset();
   compare_metrics_.reset();
   clock_.reset();
@@ -149,10 +151,19 @@ bool DemoApp::step_once(double dt) {
   metrics_.record_stage(LiveStage::kSim, static_cast<float>(t.sim_ms));
   metrics_.record_stage(LiveStage::kMediator, static_cast<float>(t.mediator_ms));
   metrics_.record_stage(LiveStage::kPose, static_cast<float>(t.pose_ms));
+  record_gait();
+  if (recorder_->lanes() != (session_->has_compare() ? 2 : 1)) reset_recorder();
+  recorder_->record(*session_, selected_id_);
   return true;
 }
 
 void DemoApp::simulate(double real_dt_s, bool scripted) {
+  if (scrubbing() && !paused_) scrub_ = -1;  // running again: the live crowd
+  if (scrubbing()) {
+    if (step_requested_) step_requested_ = false, scrub_by(1);
+    clock_.reset();
+    return;
+  }
   if (step_requested_) {
     step_requested_ = false;
     step_once(SimClock::step_s(time_scale_));
@@ -193,6 +204,16 @@ void DemoApp::simulate(double real_dt_s, bool scripted) {
       director_.pull_out_at(kShowcasePullOut_s);
     }
   }
+  if (pick_lesson_agent_ && lesson_ && session_->frame().size() > 0) {
+    pick_lesson_agent_ = false;
+    const int64_t id = agent_nearest(
+        session_->frame(), 0.5f * (session_->bounds_min() + session_->bounds_max()));
+    if (id >= 0) {
+      selected_id_ = id;
+      director_.follow(id, lesson_->distance_m, kFollowPitch_rad);
+      director_.snap();
+    }
+  }
 }
 
 Status DemoApp::render_scene(float real_dt_s) {
@@ -201,7 +222,7 @@ Status DemoApp::render_scene(float real_dt_s) {
   if (overview_yaw_) overview.yaw_rad = *overview_yaw_;
   director_.set_overview(overview);
   director_.update(session_->crowd().time_s(), real_dt_s,
-                   followed_agent(*session_, director_.followed_id()), &camera_);
+                   shown_followed(), &camera_);
   view_->camera() = camera_;
   view_->renderer().settings().lines_on_top = overlays_.any();
   context_->begin_frame();
@@ -218,7 +239,17 @@ Status DemoApp::render_scene(float real_dt_s) {
     glFinish();
     upload_ms += ms_since(t);
     t = Clock::now();
-    history.draw(*session_, lane, overlays_, selected_id_, &view_->renderer());
+    // A recorded moment has no overlay history: its bodies and the selected agent's ring only.
+    if (!scrubbing()) {
+      history.draw(*session_, lane, overlays_, selected_id_, &view_->renderer());
+    } else {
+      const auto draws = lane.draw_span();
+      const bool compare = &lane == &replay_[1];
+      for (size_t i = 0; i < draws.size(); ++i) {
+        if (shown_id(compare, i) != selected_id_) continue;
+        draw_selection_ring(draws[i].position + glm::vec3(0.0f, 0.03f, 0.0f), &view_->renderer());
+      }
+    }
     GK_RETURN_IF_ERROR(view_->draw(lane, origin, size));
     glFinish();
     render_ms += ms_since(t);
@@ -226,11 +257,10 @@ Status DemoApp::render_scene(float real_dt_s) {
   };
   if (session_->has_compare()) {
     const int left = fb.x / 2;
-    GK_RETURN_IF_ERROR(
-        lane_pass(session_->compare_lane(), *compare_history_, {0, 0}, {left, fb.y}));
-    GK_RETURN_IF_ERROR(lane_pass(session_->lane(), *history_, {left, 0}, {fb.x - left, fb.y}));
+    GK_RETURN_IF_ERROR(lane_pass(shown_lane(true), *compare_history_, {0, 0}, {left, fb.y}));
+    GK_RETURN_IF_ERROR(lane_pass(shown_lane(false), *history_, {left, 0}, {fb.x - left, fb.y}));
   } else {
-    GK_RETURN_IF_ERROR(lane_pass(session_->lane(), *history_, {0, 0}, fb));
+    GK_RETURN_IF_ERROR(lane_pass(shown_lane(false), *history_, {0, 0}, fb));
   }
   metrics_.record_stage(LiveStage::kUpload, upload_ms);
   metrics_.record_stage(LiveStage::kRender, render_ms);
@@ -247,62 +277,6 @@ const char* DemoApp::hint() const {
     return "Nobody is left in the scene: press R to restart it.";
   }
   return "";
-}
-
-void DemoApp::write_report(const std::string& path) const {
-  nlohmann::json agents = nlohmann::json::array();
-  const glm::ivec2 size = view_size();
-  const float offset = session_->has_compare() ? static_cast<float>(size.x) : 0.0f;
-  const auto draws = session_->lane().draw_span();
-  for (size_t i = 0; i < draws.size(); ++i) {
-    const ProjectedPoint p = camera_.project(draws[i].position + glm::vec3(0, 0.9f, 0), size);
-    agents.push_back({{"id", session_->frame().ids[i]},
-                      {"px", p.pixel.x + offset},
-                      {"py", p.pixel.y},
-                      {"in_front", p.in_front}});
-  }
-  nlohmann::json exhibits = nlohmann::json::array();
-  const Exhibits shown =
-      make_exhibits(session_->setup(), 0.5f * (session_->bounds_min() + session_->bounds_max()),
-                    view_->renderer().settings().wall_thickness_m);
-  for (const glm::vec3& c : shown.canvas_centers) {
-    const ProjectedPoint p = camera_.project(c, size);
-    exhibits.push_back({{"px", p.pixel.x + offset}, {"py", p.pixel.y}, {"in_front", p.in_front}});
-  }
-  nlohmann::json clips = nlohmann::json::array();
-  for (const LocomotionClip& c : session_->library().clips) {
-    clips.push_back({{"name", c.clip.name}, {"speed_m_s", c.speed_m_s}});
-  }
-  const glm::ivec2 fb = context_->framebuffer_size();
-  const glm::ivec2 scene = scene_size();
-  const nlohmann::json j = {
-      {"scene_width", scene.x},
-      {"width", fb.x},
-      {"height", fb.y},
-      {"compare", session_->has_compare()},
-      {"scenario", session_->setup().scenario_name},
-      {"agent_count", session_->setup().agents},
-      {"frames", frames_drawn_},
-      {"time_s", session_->crowd().time_s()},
-      {"paused", paused_},
-      {"help", help_},
-      {"help_rect", {help_rect_.x, help_rect_.y, help_rect_.z, help_rect_.w}},
-      {"hint", hint()},
-      {"selected", selected_id_},
-      {"following", director_.following()},
-      {"camera",
-       {{"target", {camera_.target.x, camera_.target.y, camera_.target.z}},
-        {"distance_m", camera_.distance_m},
-        {"pitch_rad", camera_.pitch_rad},
-        {"yaw_rad", camera_.yaw_rad}}},
-      {"panel", {panel_rect_.x, panel_rect_.y, panel_rect_.z, panel_rect_.w}},
-      {"status", status_},
-      {"clips", clips},
-      {"agents", agents},
-      {"exhibits", exhibits}};
-  std::ofstream out(path);
-  out << j.dump(1) << "\n";
-  if (!out) fail("demo", 1, path + ": cannot write the report");
 }
 
 int DemoApp::run() {
@@ -348,7 +322,16 @@ int DemoApp::run() {
     return 1;
   }
   context_ = std::move(context).value();
-  if (!rebuild()) {
+  const Lesson* lesson = nullptr;
+  if (!options_.lesson.empty()) {
+    lesson = find_lesson(options_.lesson);
+    if (!lesson) {
+      fail("demo", 2, "--lesson: expected " + lesson_names() + ", got '" + options_.lesson + "'");
+    }
+    if (!options_.select.empty()) fail("demo", 2, "--lesson chooses the agent: drop --select");
+  }
+  if (lesson) start_lesson(*lesson);
+  if (lesson ? !lesson_ : !rebuild()) {
     // Bad options were already reported by fail(); other errors (the renderer) were not.
     if (status_ != last_failure()) std::fprintf(stderr, "gaitkeeper demo: %s\n", status_.c_str());
     return 2;

@@ -19,8 +19,10 @@
 #include <vector>
 
 #include "app/camera_director.h"
+#include "app/crowd_recorder.h"
 #include "app/crowd_session.h"
 #include "app/file_browser.h"
+#include "app/lessons.h"
 #include "app/live_metrics.h"
 #include "app/overlays.h"
 #include "app/scene_view.h"
@@ -46,6 +48,7 @@ struct DemoOptions {
   // start of a frame, exactly where a real key press, click or wheel turn arrives (tests).
   std::vector<std::string> inputs;
   std::string report;  // JSON: panel rectangle and the agents' pixels on the last frame
+  std::string lesson;  // open on this lesson (app/lessons.h)
 };
 
 // Width of the panel docked at the right edge of the window [px]; the 3D view fills the rest.
@@ -79,6 +82,22 @@ class DemoApp {
   Status render_scene(float real_dt_s);
   void draw_overlay_text();  // app/demo_hud.cc: labels, twist, notes, hints, help
   void draw_help();
+  void start_lesson(const Lesson& lesson);  // app/demo_lessons.cc
+  void enable_split();  // the lesson's split, or naive | the chosen mode
+  void record_gait();   // the selected agent's stride and cadence, both lanes
+  void panel_gait();    // their plot against speed
+  void draw_lesson_text(float bottom_px);
+  void lessons_menu();
+  // app/demo_timeline.cc: the last minute kept in a CrowdRecorder, scrubbed from the panel.
+  void reset_recorder();
+  void panel_timeline();
+  void scrub_to(int k);  // k: a held record; past the newest: live again
+  void scrub_by(int records);
+  bool scrubbing() const { return scrub_ >= 0; }
+  // What is drawn: the recorded lane while scrubbing, else the session's. `ids` are the draws'.
+  const AnimationLane& shown_lane(bool compare) const;
+  int64_t shown_id(bool compare, size_t i) const;
+  std::optional<FollowedAgent> shown_followed() const;  // the Lessons menu in the panel's menu bar
   void draw_panel();  // app/demo_panel.cc
   void panel_crowd();
   void apply_crowd();  // rebuild from the crowd the panel shows, keeping the parameters
@@ -143,6 +162,25 @@ class DemoApp {
   glm::vec4 panel_rect_{0.0f};  // x, y, w, h [px] of the panel window, for the report
   glm::vec4 help_rect_{0.0f};   // x, y, w, h [px] of the help window while shown
   FrameCapture capture_;
+  std::optional<CrowdRecorder> recorder_;
+  int scrub_ = -1;  // the record shown, or -1: live
+  AnimationLane replay_[2];  // [0] primary, [1] compare: draws and palettes of the scrubbed record
+  std::vector<int64_t> replay_ids_[2];
+  const Lesson* lesson_ = nullptr;
+  bool pick_lesson_agent_ = false;  // follow the lesson's agent once the crowd has a frame
+  glm::vec4 lessons_menu_rect_{0.0f};
+  glm::vec4 lesson_text_rect_{0.0f};  // x, y, w, h [px] of the lesson's text box  // x, y, w, h [px] of the Lessons menu header
+  std::vector<glm::vec4> lesson_item_rects_;  // the menu's items while it is open (tests)
+  // The selected agent's gait, per lane (0 primary, 1 compare): speed [m/s], stride length [m]
+  // (one gait cycle), cadence [steps/min]; a ring of the last kGaitSamples frames.
+  struct GaitSample {
+    float speed_m_s, stride_m, cadence_spm;
+  };
+  static constexpr int kGaitSamples = 240;
+  std::vector<GaitSample> gait_[2];
+  int gait_count_ = 0;
+  int64_t gait_id_ = -1;
+  float native_stride_m_ = 0.0f, native_cadence_spm_ = 0.0f, native_speed_m_s_ = 0.0f;
 };
 
 }  // namespace gk::app

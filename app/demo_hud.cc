@@ -38,9 +38,10 @@ void DemoApp::draw_overlay_text() {
   const float base = ImGui::GetFontSize();
   char text[160];
   if (split) {
-    const std::string_view right = mediator_mode_name(session_->params().mode);
+    const std::string_view right =
+        lesson_ ? lesson_->on_label : mediator_mode_name(session_->params().mode);
     std::snprintf(text, sizeof(text), "%.*s", static_cast<int>(right.size()), right.data());
-    boxed_text(fg, ImVec2(12, 10), "naive", base * 1.4f, kWhite);
+    boxed_text(fg, ImVec2(12, 10), lesson_ ? lesson_->off_label : "naive", base * 1.4f, kWhite);
     boxed_text(fg, ImVec2(half + 12, 10), text, base * 1.4f, kWhite);
     fg->AddLine(ImVec2(half, 0), ImVec2(half, static_cast<float>(view.y)),
                 IM_COL32(20, 20, 20, 255), 2.0f);
@@ -55,11 +56,17 @@ void DemoApp::draw_overlay_text() {
                   SimClock::step_s(time_scale_) * 1000.0);
   }
   boxed_text(fg, ImVec2(12, bottom), text, base, IM_COL32(220, 220, 220, 255));
+  draw_lesson_text(bottom - base * 2.6f);
   if (clock_.behind() && !paused_) {
     std::snprintf(text, sizeof(text), "simulation at %.2fx real time (asked %.2fx): this machine "
                   "cannot keep up", clock_.achieved_rate(), time_scale_);
     boxed_text(fg, ImVec2(12, bottom - base * 1.8f), text, base * 1.2f,
                IM_COL32(255, 170, 60, 255));
+  } else if (scrubbing()) {
+    std::snprintf(text, sizeof(text), "recorded %.2f s (live %.2f s)",
+                  recorder_->time_s(scrub_), session_->crowd().time_s());
+    boxed_text(fg, ImVec2(12, bottom - base * 1.8f), text, base * 1.2f,
+               IM_COL32(120, 200, 255, 255));
   } else if (paused_) {
     boxed_text(fg, ImVec2(12, bottom - base * 1.8f), "paused (Space)", base * 1.2f,
                IM_COL32(255, 220, 90, 255));
@@ -119,6 +126,9 @@ void DemoApp::draw_help() {
       "  H       this help\n"
       "  R       restart the crowd (same seed, current parameters)\n"
       "  Esc     quit\n"
+      "  Left / Right          timeline: back / forward 0.05 s (pauses)\n"
+      "  Page Up / Page Down   timeline: back / forward 5 s\n"
+      "  Lessons menu (panel): one idea off | on, with what to look at\n"
       "\n"
       "Mouse\n"
       "  left click    select an agent: the camera follows it\n"

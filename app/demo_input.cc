@@ -20,6 +20,10 @@ int key_code(std::string name) {
   if (name == "escape" || name == "esc") return GLFW_KEY_ESCAPE;
   if (name == "enter") return GLFW_KEY_ENTER;
   if (name == "tab") return GLFW_KEY_TAB;
+  if (name == "left") return GLFW_KEY_LEFT;
+  if (name == "right") return GLFW_KEY_RIGHT;
+  if (name == "pageup") return GLFW_KEY_PAGE_UP;
+  if (name == "pagedown") return GLFW_KEY_PAGE_DOWN;
   if (name.size() == 1 && name[0] >= 'a' && name[0] <= 'z') return GLFW_KEY_A + (name[0] - 'a');
   if (name.size() == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
   return -1;
@@ -57,7 +61,7 @@ void DemoApp::parse_inputs() {
       in.key = key_code(arg);
       if (in.key < 0) {
         fail("demo", 2, where + ": unknown key '" + arg +
-                            "' (space, escape, enter, tab, a letter or a digit)");
+                            "' (space, escape, enter, tab, left, right, pageup, pagedown, a letter or a digit)");
       }
     } else if (kind == "click" || kind == "wheel") {
       const std::vector<float> v = numbers(arg, where);
@@ -100,6 +104,11 @@ void DemoApp::handle_input() {
     if (ImGui::IsKeyPressed(GLFW_KEY_H, false)) help_ = !help_;
     if (ImGui::IsKeyPressed(GLFW_KEY_R, false)) restart_requested_ = true;
     if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) quit_ = true;
+    // The timeline: one record (1/20 s) or 5 s back and forth; pauses.
+    if (ImGui::IsKeyPressed(GLFW_KEY_LEFT)) scrub_by(-1);
+    if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT)) scrub_by(1);
+    if (ImGui::IsKeyPressed(GLFW_KEY_PAGE_UP, false)) scrub_by(-CrowdRecorder::kRecordsPer5s);
+    if (ImGui::IsKeyPressed(GLFW_KEY_PAGE_DOWN, false)) scrub_by(CrowdRecorder::kRecordsPer5s);
   }
   if (io.WantCaptureMouse) return;
   const glm::vec2 mouse(io.MousePos.x, io.MousePos.y);
@@ -134,8 +143,7 @@ void DemoApp::pick(glm::vec2 mouse_px) {
   const glm::ivec2 size = view_size();
   if (session_->has_compare() && px.x >= size.x) px.x -= static_cast<float>(size.x);
   const Ray ray = camera_.pick_ray(px, size);
-  const AgentFrame& frame = session_->frame();
-  const auto draws = session_->lane().draw_span();
+  const auto draws = shown_lane(false).draw_span();
   float best = 0.6f;  // [m] from the ray to the body's axis point at hip height
   int64_t picked = -1;
   for (size_t i = 0; i < draws.size(); ++i) {
@@ -143,7 +151,7 @@ void DemoApp::pick(glm::vec2 mouse_px) {
     const float along = glm::dot(c - ray.origin, ray.direction);
     if (along <= 0.0f) continue;
     const float d = glm::length(c - (ray.origin + along * ray.direction));
-    if (d < best) best = d, picked = frame.ids[i];
+    if (d < best) best = d, picked = shown_id(false, i);
   }
   select(picked);
 }

@@ -42,7 +42,9 @@ void DemoApp::draw_panel() {
   ImGui::SetNextWindowSize(ImVec2(kPanelWidth, io.DisplaySize.y), ImGuiCond_Always);
   ImGui::SetNextWindowBgAlpha(1.0f);
   ImGui::Begin("Gaitkeeper", nullptr,
-               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                   ImGuiWindowFlags_MenuBar);
+  lessons_menu();
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   panel_rect_ = glm::vec4(pos.x, pos.y, size.x, size.y);
   if (!status_.empty()) {
@@ -53,6 +55,11 @@ void DemoApp::draw_panel() {
   ImGui::TextDisabled("Space pause, H help, R restart, Esc quit");
   if (ImGui::CollapsingHeader("Crowd", ImGuiTreeNodeFlags_DefaultOpen)) panel_crowd();
   if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) panel_view();
+  if (ImGui::CollapsingHeader("Timeline (last 60 s)", ImGuiTreeNodeFlags_DefaultOpen)) {
+    panel_timeline();
+  }
+  if (lesson_ && lesson_->rate_plot) ImGui::SetNextItemOpen(true, ImGuiCond_Always);
+  if (ImGui::CollapsingHeader("Stride and cadence against speed")) panel_gait();
   if (ImGui::CollapsingHeader("Metrics", ImGuiTreeNodeFlags_DefaultOpen)) panel_metrics();
   if (ImGui::CollapsingHeader("Selected agent", ImGuiTreeNodeFlags_DefaultOpen)) panel_agent();
   if (ImGui::CollapsingHeader("Clips")) panel_clips();
@@ -124,6 +131,7 @@ void DemoApp::panel_crowd() {
 }
 
 void DemoApp::apply_crowd() {
+  lesson_ = nullptr;  // another crowd: the lesson's text and split no longer apply
   crowd_.sim = sim_kind_ == 1 ? "detour" : "social";
   if (sim_kind_ == 2) {
     crowd_.scenario = replay_path_;
@@ -176,11 +184,12 @@ void DemoApp::panel_view() {
   if (ImGui::Button("restart")) restart_requested_ = true;
   row("time scale");
   ImGui::SliderFloat("##time_scale", &time_scale_, 0.05f, 2.0f, "%.2fx");
-  if (ImGui::Checkbox("compare naive | apm", &compare_)) {
-    if (compare_) {
-      session_->enable_compare(MediatorMode::kNaive);
-      compare_history_.emplace(*session_, session_->crowd().capacity());
-      compare_metrics_.reset();
+  if (ImGui::Checkbox(lesson_ ? "compare the lesson's idea off | on" : "compare naive | apm",
+                      &compare_)) {
+    if (compare_ && lesson_ && lesson_->own_crowd) {
+      start_lesson(*lesson_);  // each half's own crowd starts together
+    } else if (compare_) {
+      enable_split();
     } else {
       session_->disable_compare();
     }
@@ -234,8 +243,10 @@ void DemoApp::panel_metrics() {
     const auto series = static_cast<LiveSeries>(s);
     char overlay[64];
     if (session_->has_compare() && compare_metrics_.count() > 0) {
-      std::snprintf(overlay, sizeof(overlay), "%.2f %s (naive %.2f)", metrics_.mean(series),
-                    LiveMetrics::unit(series), compare_metrics_.mean(series));
+      // The left half's figure, named as the split names it.
+      std::snprintf(overlay, sizeof(overlay), "%.2f %s (%s %.2f)", metrics_.mean(series),
+                    LiveMetrics::unit(series), lesson_ ? lesson_->off_label : "naive",
+                    compare_metrics_.mean(series));
     } else {
       std::snprintf(overlay, sizeof(overlay), "%.2f %s (5 s mean)", metrics_.mean(series),
                     LiveMetrics::unit(series));
@@ -257,6 +268,21 @@ void DemoApp::panel_metrics() {
 void DemoApp::panel_agent() {
   if (selected_id_ < 0) {
     ImGui::TextDisabled("click an agent to follow it");
+    return;
+  }
+  if (scrubbing()) {
+    // The recorded moment: what the record holds of this agent.
+    const auto a = recorder_->agent(scrub_, 0, selected_id_);
+    if (!a) {
+      ImGui::Text("agent %lld is not in the scene at t = %.2f s",
+                  static_cast<long long>(selected_id_), recorder_->time_s(scrub_));
+      return;
+    }
+    ImGui::Text("agent %lld at t = %.2f s (recorded)", static_cast<long long>(selected_id_),
+                recorder_->time_s(scrub_));
+    ImGui::Text("position (%.2f, %.2f) m  speed %.2f m/s", a->root_xz.x, a->root_xz.y,
+                glm::length(a->velocity_xz));
+    ImGui::Text("playback rate %.2fx  %s", a->playback_rate, a->posed ? "" : "(not posed)");
     return;
   }
   const AgentFrame& frame = session_->frame();

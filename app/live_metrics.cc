@@ -20,7 +20,7 @@ void unroll(const std::array<float, LiveMetrics::kWindow>& ring, int count,
 
 void LiveMetrics::record(const CrowdSession& session, const AnimationLane& lane,
                          const OverlayHistory& history) {
-  const AgentFrame& frame = session.frame();
+  const AgentFrame& frame = session.frame_of(lane);
   const AnimationPlans& plans = lane.mediator->plans();
   double torsion = 0.0, rate = 0.0, root_error = 0.0;
   // METRICS.md v2 on this frame: walking agents with neither toe within 5 cm of its floor, and

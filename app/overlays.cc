@@ -106,7 +106,7 @@ bool enable_overlay(const std::string& n, OverlayToggles* t) {
 
 std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
                                           int64_t agent_id) {
-  const AgentFrame& frame = session.frame();
+  const AgentFrame& frame = session.frame_of(lane);
   const AnimationPlans& plans = lane.mediator->plans();
   for (size_t i = 0; i < frame.size(); ++i) {
     if (frame.ids[i] != agent_id) continue;
@@ -118,7 +118,7 @@ std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const Ani
     out.head = glm::vec3(root.x, 2.05f, root.y);
     out.twist_deg = glm::degrees(angle_to(pelvis, lane.poses->upper_heading(slot)));
     out.theta_deg = glm::degrees(angle_to(pelvis, frame.thetas[i]));
-    out.limit_deg = session.params().torsion_limit_deg;
+    out.limit_deg = lane.mediator->params().torsion_limit_deg;
     return out;
   }
   return std::nullopt;
@@ -140,7 +140,7 @@ OverlayHistory::OverlayHistory(const CrowdSession& session, size_t capacity)
 }
 
 void OverlayHistory::record(const CrowdSession& session, const AnimationLane& lane, float dt_s) {
-  const AgentFrame& frame = session.frame();
+  const AgentFrame& frame = session.frame_of(lane);
   const AnimationPlans& plans = lane.mediator->plans();
   // METRICS.md v2: the support foot (the lower toe against its floor) within 5 cm of that floor.
   constexpr float kNearFloor_m = 0.05f;
@@ -185,7 +185,7 @@ void OverlayHistory::record(const CrowdSession& session, const AnimationLane& la
 
 void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane,
                           const OverlayToggles& t, int64_t selected_id, CrowdRenderer* r) const {
-  const AgentFrame& frame = session.frame();
+  const AgentFrame& frame = session.frame_of(lane);
   const AnimationPlans& plans = lane.mediator->plans();
   const PoseSynthesizer& poses = *lane.poses;
   const FootLocks& locks = poses.foot_locks();
@@ -251,15 +251,19 @@ void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane
       if (t.torso) {
         const int s = static_cast<int>(slot);
         torso_fan(r, ground, poses.pelvis_heading(s), poses.upper_heading(s), frame.thetas[i],
-                  glm::radians(session.params().torsion_limit_deg));
+                  glm::radians(lane.mediator->params().torsion_limit_deg));
       }
-      constexpr int kSegments = 24;
-      for (int k = 0; k < kSegments; ++k) {
-        const float a0 = 6.2831853f * k / kSegments, a1 = 6.2831853f * (k + 1) / kSegments;
-        r->add_line(ground + 0.5f * glm::vec3(std::cos(a0), 0, std::sin(a0)),
-                    ground + 0.5f * glm::vec3(std::cos(a1), 0, std::sin(a1)), {1.0f, 0.2f, 0.9f});
-      }
+      draw_selection_ring(ground, r);
     }
+  }
+}
+
+void draw_selection_ring(const glm::vec3& ground, CrowdRenderer* r) {
+  constexpr int kSegments = 24;
+  for (int k = 0; k < kSegments; ++k) {
+    const float a0 = 6.2831853f * k / kSegments, a1 = 6.2831853f * (k + 1) / kSegments;
+    r->add_line(ground + 0.5f * glm::vec3(std::cos(a0), 0, std::sin(a0)),
+                ground + 0.5f * glm::vec3(std::cos(a1), 0, std::sin(a1)), {1.0f, 0.2f, 0.9f});
   }
 }
 

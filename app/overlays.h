@@ -47,6 +47,9 @@ struct TorsoReadout {
 std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
                                           int64_t agent_id);
 
+// The selected agent's ring (magenta, 0.5 m) around `ground` (its root, just above the floor).
+void draw_selection_ring(const glm::vec3& ground, CrowdRenderer* renderer);
+
 // Slide speed [m/s] from which a trail sample is fully red: METRICS.md's skate threshold.
 inline constexpr float kSkateSpeed_m_s = 0.30f;
 

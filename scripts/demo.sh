@@ -26,3 +26,6 @@ echo "== gaitkeeper bench --scenario bottleneck --mode naive | apm  (the same cr
 echo
 echo "Wrote out/demo.mp4 and out/demo.png (left: naive, right: apm). Run it with a display"
 echo "for the window, or see: $gk --help"
+echo "Lessons, one idea off | on each: $gk render --lesson NAME --out FILE.png|FILE.mp4"
+echo "  (foot-sliding, playback-rate, foot-locking, torso-decoupling, feedback; in the window:"
+echo "  the Lessons menu, or $gk demo --lesson NAME)"

@@ -17,50 +17,11 @@
 
 #include "render/camera.h"
 #include "tests/app/cli_support.h"
+#include "tests/app/window/demo_support.h"
 #include "tests/test_data.h"
 
 namespace gk {
 namespace {
-
-// A macro: GTEST_SKIP and FAIL return from the test itself only when written in its body.
-#define GK_REQUIRE_DISPLAY()                                                                 \
-  do {                                                                                       \
-    const char* gk_display_ = std::getenv("DISPLAY");                                        \
-    if (!gk_display_ || !*gk_display_) {                                                     \
-      if (test::under_ci()) FAIL() << "the window tests need a display under CI (xvfb-run)"; \
-      GTEST_SKIP() << "DISPLAY is not set; CTest runs these through xvfb-run";               \
-    }                                                                                        \
-  } while (0)
-
-struct Shot {
-  test::Image image;
-  nlohmann::json report;
-};
-
-Shot run_demo(const std::string& name, const std::string& args,
-              const std::string& size = "1024x576") {
-  const std::string dir = test::scratch_dir("demo");
-  const std::string png = dir + "/" + name + ".png", json = dir + "/" + name + ".json";
-  std::remove(png.c_str());
-  std::remove(json.c_str());
-  const test::CommandResult r = test::run_gaitkeeper("demo --size " + size + " " + args +
-                                                     " --screenshot " + png + " --report " + json);
-  EXPECT_EQ(r.code, 0) << r.out;
-  Shot shot;
-  shot.image = test::read_png(png);
-  std::ifstream in(json);
-  if (in) shot.report = nlohmann::json::parse(in);
-  return shot;
-}
-
-// Mean colour of a rectangle.
-glm::vec3 mean_color(const test::Image& img, int x0, int y0, int x1, int y1) {
-  glm::dvec3 sum(0.0);
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) sum += glm::dvec3(glm::vec3(img.at(x, y)));
-  }
-  return glm::vec3(sum / static_cast<double>((x1 - x0) * (y1 - y0)));
-}
 
 TEST(Demo, WindowShowsCrowdAndPanel) {
   GK_REQUIRE_DISPLAY();
@@ -334,7 +295,7 @@ TEST(DemoPanel, ANewScenarioComesWithItsOwnAgentCountAndAPausedOneSaysSo) {
   // Gallery with 6 agents, paused; the scenario combo opened, "circle" chosen from its list.
   const Shot s = run_demo("scenario_change",
                           "--scenario gallery --agents 6 --frames 10 --input 1:key:space "
-                          "--input 3:click:1160,99 --input 6:click:1100,141",
+                          "--input 3:click:1160,119 --input 6:click:1100,161",
                           "1280x720");
   EXPECT_EQ(s.report["scenario"].get<std::string>(), "circle") << s.report["status"];
   EXPECT_EQ(s.report["agent_count"].get<int>(), 24) << "circle.json's default_agents, not 6";
@@ -356,8 +317,8 @@ TEST(DemoPanel, TheFolderBrowserLoadsAFolderOfClips) {
   // Untick "built-in", press "browse...", then "this folder".
   const std::string dir = test::scratch_dir("demo");
   const test::CommandResult r = test::run_gaitkeeper(
-      "demo --size 1280x720 --scenario gallery --agents 6 --frames 12 --input 2:click:1082,145 "
-      "--input 5:click:940,191 --input 9:click:794,525 --report " + dir + "/browser.json",
+      "demo --size 1280x720 --scenario gallery --agents 6 --frames 12 --input 2:click:1082,165 "
+      "--input 5:click:940,211 --input 9:click:794,525 --report " + dir + "/browser.json",
       "GAITKEEPER_DATA=" + root + " ");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream in(dir + "/browser.json");

@@ -1,0 +1,97 @@
+#include "app/lessons.h"
+
+#include <glm/geometric.hpp>
+
+namespace gk::app {
+namespace {
+
+OverlayToggles overlays(bool trails, bool planted, bool velocity, bool theta, bool torso) {
+  OverlayToggles t;
+  t.trails = trails;
+  t.planted = planted;
+  t.velocity = velocity;
+  t.theta = theta;
+  t.torso = torso;
+  return t;
+}
+
+void keep(MediatorParams*) {}
+void naive(MediatorParams* p) { p->mode = MediatorMode::kNaive; }
+void rate_only(MediatorParams* p) { p->mode = MediatorMode::kRate; }
+void no_locking(MediatorParams* p) { p->foot_locking = false; }
+// No twist allowed: the upper body cannot turn away from the legs.
+void no_twist(MediatorParams* p) { p->torsion_limit_deg = 0.0f; }
+void no_feedback(MediatorParams* p) { p->feedback = false; }
+
+const Lesson kLessons[] = {
+    {"foot-sliding", "Foot sliding", "bottleneck", 0, 1, 0.5f, true, 180.0f, 7.0f,
+     overlays(true, false, false, false, false), "naive", "apm", naive, keep, false, false,
+     "Left, naive animation: one clip at its own speed while the simulator moves the body at "
+     "another, so feet smear over the ground (red trails). Right, the mediator: every planted "
+     "foot leaves a still, green footprint. Watch the followed agent's feet at half speed.",
+     "FOOT SLIDING - RED TRAILS: FEET SKATE. GREEN: FEET STAND STILL"},
+    {"playback-rate", "Playback-rate matching", "crossing", 24, 1, 0.5f, true, 110.0f, 7.0f,
+     overlays(true, false, false, false, false), "naive", "rate", naive, rate_only, false, true,
+     "Left, naive: the clip plays at its native rate whatever the agent's speed. Right, rate "
+     "matching only: the clip plays faster or slower so its stride speed equals the walking "
+     "speed. The panel plots the selected agent's stride length and cadence against its speed "
+     "beside the clip's own values; most sliding goes, except in turns and speed changes.",
+     "RATE MATCHING - CLIP PLAYED AT AGENT SPEED / CLIP SPEED"},
+    {"foot-locking", "Foot locking", "crossing", 12, 1, 0.5f, true, 200.0f, 5.0f,
+     overlays(true, true, false, false, false), "locking off", "locking on", no_locking, keep,
+     false, false,
+     "Both halves run the whole mediator; only foot locking differs (parameter foot_locking). "
+     "White crosses mark feet pinned in world space by two-bone IK: on the right the toe stays "
+     "on its cross until the clip lifts it, on the left what rate matching leaves still slides, "
+     "most in turns and stops.",
+     "FOOT LOCKING - WHITE CROSSES: PINNED FEET"},
+    {"torso-decoupling", "Torso decoupling", "gallery", 24, 1, 0.5f, true, 160.0f, 6.0f,
+     overlays(false, false, false, true, true), "no twist", "twist 60 deg", no_twist, keep, false,
+     false,
+     "Visitors walk past the exhibits and look at them (yellow: where the agent looks). Right: "
+     "the legs follow the walking direction, the upper body turns toward the exhibit within the "
+     "60 degree limit (fan: blue pelvis, orange chest, white arc the limit). Left, no twist "
+     "allowed: the body turns as one piece and cannot look.",
+     "TORSO DECOUPLING - BLUE PELVIS, ORANGE CHEST, YELLOW LOOK"},
+    {"feedback", "Feedback", "bottleneck", 0, 1, 0.5f, true, 180.0f, 7.0f,
+     overlays(true, false, true, false, false), "feedback off", "feedback on", no_feedback, keep,
+     true, false,
+     "Each half runs its own crowd; only the right one tells the simulator what the animation "
+     "can deliver (speed, walking direction, torso theta). Feedback corrects only what the "
+     "animation cannot follow (faster than the fastest clip, a turn faster than the legs, a look "
+     "beyond the twist limit): the halves stay close, and part where a green velocity arrow "
+     "asks for more than the legs can give.",
+     "FEEDBACK - GREEN ARROW: SIMULATOR VELOCITY"},
+};
+
+}  // namespace
+
+std::span<const Lesson> lessons() { return kLessons; }
+
+const Lesson* find_lesson(std::string_view name) {
+  for (const Lesson& l : kLessons) {
+    if (name == l.name) return &l;
+  }
+  return nullptr;
+}
+
+std::string lesson_names() {
+  std::string out;
+  for (const Lesson& l : kLessons) {
+    if (!out.empty()) out += ", ";
+    out += l.name;
+  }
+  return out;
+}
+
+int64_t agent_nearest(const AgentFrame& frame, glm::vec2 point) {
+  float best = 1e30f;
+  int64_t id = -1;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const float d = glm::length(frame.positions[i] - point);
+    if (d < best) best = d, id = frame.ids[i];
+  }
+  return id;
+}
+
+}  // namespace gk::app
