@@ -5,10 +5,12 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include <glm/gtc/type_precision.hpp>
+#include <nlohmann/json.hpp>
 
 namespace gk::test {
 
@@ -20,6 +22,12 @@ struct CommandResult {
 // `env` is prepended to the command line (e.g. "DISPLAY= "). Mesa keeps driver allocations past
 // context destruction, so commands that open a GL context run with leak detection off under ASan
 // (ASan and UBSan themselves stay on).
+// A JSON file a command wrote (null when it cannot be read).
+inline nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return in ? nlohmann::json::parse(in) : nlohmann::json();
+}
+
 inline CommandResult run_gaitkeeper(const std::string& args, const std::string& env = "") {
   CommandResult r;
   const std::string cmd =
@@ -51,3 +59,13 @@ inline int pixel_difference(glm::u8vec4 a, glm::u8vec4 b) {
 }
 
 }  // namespace gk::test
+
+// Runs a render command into `result`; skips the test (fails it under CI) when no OpenGL context
+// can be had, and asserts success otherwise.
+#define GK_RUN_RENDER(result, args)                                                    \
+  const ::gk::test::CommandResult result = ::gk::test::run_gaitkeeper(args);           \
+  if (result.code != 0 && result.out.find("no OpenGL context") != std::string::npos) { \
+    if (::gk::test::under_ci()) FAIL() << "offscreen GL required under CI: " << result.out; \
+    GTEST_SKIP() << "offscreen GL unavailable: " << result.out;                        \
+  }                                                                                    \
+  ASSERT_EQ(result.code, 0) << result.out

@@ -24,13 +24,11 @@
 namespace gk {
 namespace {
 
+using test::read_json;
+
 using test::CommandResult;
 CommandResult run(const std::string& args) { return test::run_gaitkeeper(args); }
 
-nlohmann::json read_json(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
 
 TEST(Cli, AnalyzeClipCoversEverySharedClip) {
   GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");

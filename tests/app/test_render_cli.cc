@@ -18,14 +18,6 @@ namespace {
 // A fixed camera so that two runs with different crowds see the same background.
 constexpr const char* kCamera = "--camera 35,40,30,0,0 --size 480x270";
 
-// Runs a render command; skips (fails under CI) when no GL context can be had.
-#define GK_RUN_RENDER(result, args)                                                    \
-  const test::CommandResult result = test::run_gaitkeeper(args);                       \
-  if (result.code != 0 && result.out.find("no OpenGL context") != std::string::npos) { \
-    if (test::under_ci()) FAIL() << "offscreen GL required under CI: " << result.out;  \
-    GTEST_SKIP() << "offscreen GL unavailable: " << result.out;                        \
-  }                                                                                    \
-  ASSERT_EQ(result.code, 0) << result.out
 
 TEST(RenderCli, AgentsAppearWhereProjected) {
   const std::string dir = test::scratch_dir("render_cli");

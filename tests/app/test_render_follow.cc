@@ -16,18 +16,9 @@
 namespace gk {
 namespace {
 
-#define GK_RUN_RENDER(result, args)                                                    \
-  const test::CommandResult result = test::run_gaitkeeper(args);                       \
-  if (result.code != 0 && result.out.find("no OpenGL context") != std::string::npos) { \
-    if (test::under_ci()) FAIL() << "offscreen GL required under CI: " << result.out;  \
-    GTEST_SKIP() << "offscreen GL unavailable: " << result.out;                        \
-  }                                                                                    \
-  ASSERT_EQ(result.code, 0) << result.out
+using test::read_json;
 
-nlohmann::json read_json(const std::string& path) {
-  std::ifstream in(path);
-  return in ? nlohmann::json::parse(in) : nlohmann::json();
-}
+
 
 const nlohmann::json* agent(const nlohmann::json& report, int64_t id) {
   for (const auto& a : report["agents"]) {
