@@ -13,7 +13,7 @@ void measure_contacts(std::span<const glm::vec3> toe, std::span<const glm::vec3>
   for (const glm::vec3& p : toe) min_t = std::min(min_t, p.y);
   for (const glm::vec3& p : ankle) min_a = std::min(min_a, p.y);
   for (size_t i = 0; i < toe.size(); ++i) {
-    out_contact[i] = toe[i].y <= min_t + 0.025f && ankle[i].y <= min_a + 0.05f;
+    out_contact[i] = toe[i].y <= min_t + kContactToeBandM && ankle[i].y <= min_a + kContactAnkleBandM;
   }
 }
 

@@ -12,8 +12,15 @@
 
 namespace gk {
 
-// Contact per METRICS.md: toe.y <= min(toe.y) + 0.025 and ankle.y <= min(ankle.y) + 0.05, with the
-// minima over the whole track. out_contact must have the tracks' length.
+// METRICS.md v1's definitions (the metric's, not tuning): a foot is in contact while its toe is
+// within kContactToeBandM and its ankle within kContactAnkleBandM of their lowest heights; a
+// contact sample faster than kSkateThresholdCmS skates.
+inline constexpr float kContactToeBandM = 0.025f;
+inline constexpr float kContactAnkleBandM = 0.05f;
+inline constexpr float kSkateThresholdCmS = 30.0f;
+
+// Contact per METRICS.md v1, with the minima over the whole track. out_contact must have the
+// tracks' length.
 void measure_contacts(std::span<const glm::vec3> toe, std::span<const glm::vec3> ankle,
                       std::span<uint8_t> out_contact);
 
@@ -21,7 +28,6 @@ void measure_contacts(std::span<const glm::vec3> toe, std::span<const glm::vec3>
 // (> 30 cm/s) and drift per contact interval.
 class SlideAccumulator {
  public:
-  static constexpr float kSkateThresholdCmS = 30.0f;
   // toe/ankle: one foot's positions on consecutive frames dt_s apart.
   void add_track(std::span<const glm::vec3> toe, std::span<const glm::vec3> ankle, float dt_s);
   // Adds a track whose contact flags are already known.

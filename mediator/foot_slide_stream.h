@@ -25,6 +25,7 @@
 #include <glm/vec3.hpp>
 
 #include "animation/analysis.h"
+#include "animation/foot_metrics.h"
 #include "mediator/quantile_sketch.h"
 
 namespace gk {
@@ -40,10 +41,10 @@ struct FootSlideResult {
 class FootSlideStream {
  public:
   static constexpr float kLag_s = 2.0f;
-  // METRICS.md's contact band above the lowest heights [m] and skating speed [cm/s].
-  static constexpr float kToeBandM = 0.025f;
-  static constexpr float kAnkleBandM = 0.05f;
-  static constexpr float kSkateCmS = 30.0f;
+  // METRICS.md v1's definitions, shared with the exact measure (animation/foot_metrics.h).
+  static constexpr float kToeBandM = kContactToeBandM;
+  static constexpr float kAnkleBandM = kContactAnkleBandM;
+  static constexpr float kSkateCmS = kSkateThresholdCmS;
 
   // num_feet: feet that can be followed at once (2 x agents); dt_s: the frame time.
   FootSlideStream(size_t num_feet, float dt_s);
