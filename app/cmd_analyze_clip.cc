@@ -1,6 +1,7 @@
-// `gaitkeeper analyze-clip FILE... [--scale S] [--json]`: loads BVH/glTF clips (or the built-in
-// set, FILE = "builtin") and prints each clip's analysis: speed, direction, cycle, foot contacts
-// and the foot-slide floor of METRICS.md.
+// `gaitkeeper analyze-clip FILE... [--scale S] [--roles F] [--plot F.png] [--json]`: loads
+// BVH/glTF clips (or the built-in set, FILE = "builtin") and prints each clip's analysis (speed,
+// direction, cycle, foot contacts, the foot-slide floor of METRICS.md) and, for a take, its
+// segments, strides, the loops cut from it and its problems; --plot draws them.
 
 #include <cmath>
 #include <cstdio>
@@ -248,7 +249,8 @@ void add_analyze_clip_command(CLI::App& app) {
   auto opt = std::make_shared<AnalyzeOptions>();
   CLI::App* cmd = app.add_subcommand(
       "analyze-clip",
-      "Analyse clips: native speed and direction, gait cycle, foot contacts, foot-slide floor.");
+      "Analyse clips: native speed and direction, gait cycle, foot contacts, foot-slide floor; "
+      "a take's segments (idle, start, steady, turn, stop) and the loops cut from it.");
   cmd->add_option("files", opt->files,
                   "BVH, glTF or GLB files, folders of them, or 'builtin' for the built-in set")
       ->required();
