@@ -184,7 +184,13 @@ void TwoBoneIKJob::run() const {
   const float reach = glm::length(target - a);
   const float max_len = (lab + lcb) * max_extension;
   const float min_len = std::abs(lab - lcb) + 1e-4f;
-  const float lat = std::clamp(reach, min_len, std::max(min_len, max_len));
+  float soft_reach = reach;
+  const float soft_start = max_len * std::clamp(soften, 0.0f, 1.0f);
+  const float soft_span = max_len - soft_start;
+  if (soft_span > 1e-6f && reach > soft_start) {
+    soft_reach = soft_start + soft_span * (1.0f - std::exp(-(reach - soft_start) / soft_span));
+  }
+  const float lat = std::clamp(soft_reach, min_len, std::max(min_len, max_len));
   if (out_reached) *out_reached = reach <= max_len && reach >= min_len;
 
   // Current and desired interior angles.

@@ -73,6 +73,10 @@ struct TwoBoneIKJob {
   float weight = 1.0f;               // [0, 1]: 0 leaves the pose unchanged
   // Fraction of the full limb length never exceeded, so the knee never snaps straight.
   float max_extension = 0.999f;
+  // Soft IK: beyond this fraction of max_extension the chain reaches ever less of the remaining
+  // distance (an exponential approach, continuous in value and slope), so a knee straightens
+  // smoothly instead of snapping as the target crosses full reach (1 = off, a hard clamp).
+  float soften = 1.0f;
   glm::quat* out_start_correction = nullptr;
   glm::quat* out_mid_correction = nullptr;
   bool* out_reached = nullptr;  // optional: target within reach

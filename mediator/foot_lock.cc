@@ -27,6 +27,7 @@ void release_foot_lock(FootLock& lock, const glm::vec3& drawn_toe, const glm::ve
   lock.from = drawn_toe;
   lock.offset = drawn_toe - anim_toe;
   lock.offset_vel = drawn_vel - anim_vel;
+
   lock.shed = lock.shed_from = lock.shed_goal = lock.released_s = 0.0f;
   lock.swing_from = -1.0f;  // taken from the first frame's progress
 }
@@ -62,13 +63,16 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
 
   switch (lock.state) {
     case FootLockState::kFree:
-    case FootLockState::kReleasing:
-      if (in.plant) {
-        // Pinned where it was drawn last frame: the foot stops on the frame it plants instead of
-        // taking one more step of the clip's (still slowing) foot.
-        lock_here(in.fresh ? in.anim_toe : in.drawn_toe_prev);
-      }
+    case FootLockState::kReleasing: {
+      // The clips plant the foot while its ball may still roll down and forward off the heel
+      // (and a blend of clips lands a foot over a few frames): it is pinned once the ball has come
+      // to rest over the ground, or has stopped slowing down, where it was drawn last frame.
+      const float speed = std::hypot(anim_vel.x, anim_vel.z);
+      const bool at_rest = in.fresh || speed <= in.still_speed_m_s ||
+                           (lock.anim_speed >= 0.0f && speed >= lock.anim_speed);
+      if (in.plant && at_rest) lock_here(in.fresh ? in.anim_toe : in.drawn_toe_prev);
       break;
+    }
     case FootLockState::kLocked: {
       if (!in.hold) {
         release_foot_lock(lock, pinned_goal() + lock.offset, glm::vec3(0.0f), in.anim_toe,
@@ -157,6 +161,8 @@ glm::vec3 step_foot_lock(FootLock& lock, const FootLockInput& in, const FootLock
     lock.last_goal = in.anim_toe;
   }
   const glm::vec3 goal = advance(lock, in, p, dt);
+  lock.anim_speed =
+      in.fresh ? -1.0f : std::hypot(in.anim_toe.x - in.anim_toe_prev.x, in.anim_toe.z - in.anim_toe_prev.z) / dt;
   lock.goal_vel = in.fresh ? glm::vec3(0.0f) : (goal - lock.last_goal) / dt;
   lock.last_goal = goal;
   return goal;

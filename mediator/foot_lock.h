@@ -35,6 +35,7 @@ struct FootLock {
   float shed_from = 0.0f;      // releasing: share shed when that progress was taken
   float shed_goal = 0.0f;      // releasing: share the swing's progress asks for
   float released_s = 0.0f;     // releasing: time since the release [s]
+  float anim_speed = -1.0f;    // the clip's toe speed over the ground last frame [m/s] (< 0: none)
 };
 
 struct FootLockInput {
@@ -47,6 +48,10 @@ struct FootLockInput {
   float swing_progress = 0.0f;     // the clips' swing of this foot, 0 at lift-off, 1 at landing
   bool other_locked = false;       // the other foot is pinned (one foot steps at a time)
   float floor_toe_m = 0.0f;        // where planted toes are (library floor) [m]
+  // A ball this slow over the ground is at rest (clip analysis's "still": half the travel speed,
+  // at least its capture-jitter floor) [m/s]. A plant pins the foot once its ball is at rest, or
+  // once it has stopped slowing down: at its slowest, so the drawn foot stops with no jolt.
+  float still_speed_m_s = 0.0f;
 };
 
 struct FootLockParams {

@@ -36,6 +36,11 @@ constexpr float kDropHalflife = 0.05f;  // [s]
 // foot's plantarflexion at toe-off): the pivot never turns a foot past standing on its tip.
 constexpr float kMaxHeelOff = 1.0f;
 
+// Legs straighten smoothly over the last part of their reach (soft IK): near full extension a
+// knee's position changes ever faster with the foot's distance, and a hard clamp snaps it.
+constexpr float kIkMaxExtension = 0.999f;
+constexpr float kIkSoften = 0.98f;
+
 // How much more the foot may pitch up from its elevation (toe -> ankle vector d) [rad].
 float heel_room(const glm::vec3& d) {
   const float len = glm::length(d);
@@ -283,9 +288,12 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     in.plant = pl.plant[side][slot] >= 0.5f;
     in.hold = pl.hold[side][slot] >= 0.5f;
     in.swing_progress = pl.swing_progress[side][slot];
-    in.other_locked =
-        locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
+    const FootLockState other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
+    in.other_locked = other == FootLockState::kLocked;
     in.floor_toe_m = library_.planted_toe_m[side];
+    in.still_speed_m_s =
+        std::max(ContactThresholds{}.min_still_speed_m_s,
+                 ContactThresholds{}.still_fraction_of_travel * pl.speed_m_s[slot]);
     goal[side] = step_foot_lock(locks_.lock[k], in, lp, dt);
     anim_vel[side] = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
 
@@ -362,9 +370,13 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     const glm::vec3 d = goal_ankle - toe_goal;
     if (glm::length(glm::cross(d, glm::vec3(0, 1, 0))) > 1e-6f) {
       pitch_axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
-      if (glm::length(goal_ankle - hip_p) > limit &&
+      // The heel rises as soon as the leg would have to straighten into the soft end of its
+      // reach, where IK no longer gets all the way: the pinned ball stays where it is.
+      const float pivot_limit = std::max(kIkSoften * kIkMaxExtension * library_.leg_length_m[side],
+                                         glm::length(anim_ankle - hip_p));
+      if (glm::length(goal_ankle - hip_p) > std::min(limit, pivot_limit) &&
           locks_.lock[k].state == FootLockState::kLocked) {
-        reach_pitch = heel_off_pivot(toe_goal, goal_ankle, hip_p, limit);
+        reach_pitch = heel_off_pivot(toe_goal, goal_ankle, hip_p, pivot_limit);
       }
       floor_pitch = heel_to_floor(toe_goal, d, library_.planted_ankle_m[side]);
     }
@@ -386,11 +398,12 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
       const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
       const bool other_locked =
           locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
-      if (pl.plant[side][slot] >= 0.5f && other_locked) {
+        if (pl.plant[side][slot] >= 0.5f && other_locked) {
         start_foot_step(locks_.lock[k], drawn);
       } else {
-        release_foot_lock(locks_.lock[k], drawn, glm::vec3(0.0f),
-                          translation_of(world_[base + skeleton_.toe(sd)]), anim_vel[side]);
+        // Both in the space of the lock's goals (the body before its drop): the offset is what
+        // really separates the drawn toe from the clip's, not the drop as well.
+        release_foot_lock(locks_.lock[k], drawn, glm::vec3(0.0f), anim_toe[side], anim_vel[side]);
       }
     }
     const glm::vec3 knee_p = translation_of(world_[base + knee]);
@@ -404,6 +417,8 @@ void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& ro
     ik.end_model = world_[base + ankle];
     ik.target = goal_ankle;
     ik.pole = pole;
+    ik.soften = kIkSoften;
+    ik.max_extension = kIkMaxExtension;
     ik.out_start_correction = &c_hip;
     ik.out_mid_correction = &c_knee;
     ik.run();

@@ -184,6 +184,62 @@ TEST(TwoBoneIKJob, OutOfReachStretchesTowardTarget) {
   EXPECT_GT(glm::dot(glm::normalize(end), glm::normalize(target)), 0.9999f);
 }
 
+// Soft IK: a target pulled straight away from the hip through full reach, 1 mm per step. The
+// hard clamp moves the knee by far more in the last millimetres than anywhere else (the knee's
+// distance from the hip-target line is l*sin(acos(d/2l)), whose slope is unbounded at d = 2l);
+// softened, the knee's step stays near its step well inside the reach, the foot lands exactly
+// where asked below the soft zone and never goes past the limb's length.
+TEST(TwoBoneIKJob, SoftenedKneeStraightensWithoutASnap) {
+  const float bone = 0.4f;
+  const Skeleton s = make_chain(3, bone);
+  auto knee_and_end = [&](float dist, float soften, glm::vec3* end) {
+    std::vector<glm::quat> r(3, glm::quat(1, 0, 0, 0));
+    r[1] = glm::angleAxis(glm::radians(40.0f), glm::vec3(1, 0, 0));
+    std::vector<glm::mat4> m(3);
+    LocalToModelJob fk{&s, r, s.rest_translations, glm::mat4(1), m};
+    fk.run();
+    const glm::vec3 dir = glm::normalize(translation_of(m[2]) - translation_of(m[0]));
+    glm::quat c0, c1;
+    TwoBoneIKJob ik;
+    ik.start_model = m[0];
+    ik.mid_model = m[1];
+    ik.end_model = m[2];
+    ik.target = translation_of(m[0]) + dir * dist;
+    ik.pole = glm::vec3(0, 0, 1);
+    ik.soften = soften;
+    ik.out_start_correction = &c0;
+    ik.out_mid_correction = &c1;
+    ik.run();
+    r[0] = r[0] * c0;
+    r[1] = r[1] * c1;
+    fk.run();
+    *end = translation_of(m[2]) - translation_of(m[0]);
+    return translation_of(m[1]);
+  };
+  auto largest_knee_step = [&](float soften, float from, float to) {
+    float worst = 0.0f;
+    glm::vec3 end;
+    glm::vec3 prev = knee_and_end(from, soften, &end);
+    for (float d = from + 0.001f; d <= to; d += 0.001f) {
+      const glm::vec3 k = knee_and_end(d, soften, &end);
+      worst = std::max(worst, glm::length(k - prev));
+      prev = k;
+      EXPECT_LE(glm::length(end), 2.0f * bone + 1e-4f);
+    }
+    return worst;
+  };
+  const float inside = largest_knee_step(1.0f, 0.5f, 0.6f);  // well within reach
+  const float hard = largest_knee_step(1.0f, 0.70f, 0.85f);
+  const float soft = largest_knee_step(0.95f, 0.70f, 0.85f);
+  EXPECT_GT(hard, 4.0f * inside) << hard << " " << inside;
+  EXPECT_LT(soft, 3.0f * inside) << soft << " " << inside;
+  EXPECT_LT(soft, 0.25f * hard) << soft << " " << hard;
+  // Below the soft zone the end joint is exactly where asked.
+  glm::vec3 end;
+  knee_and_end(0.7f, 0.95f, &end);
+  EXPECT_NEAR(glm::length(end), 0.7f, 1e-4f);
+}
+
 TEST(SkinningPaletteJob, BindPoseGivesIdentity) {
   const Skeleton s = make_chain(4, 0.3f);
   std::vector<glm::mat4> m(4), inv(4), pal(4);

@@ -27,7 +27,7 @@ struct Foot {
   glm::vec3 goal{0.0f}, anim{0.0f};
   bool started = false;
   glm::vec3 step(const glm::vec3& anim_toe, bool plant, bool hold, float progress = 0.0f,
-                 bool other_locked = false) {
+                 bool other_locked = false, float still_speed = 0.0f) {
     FootLockInput in;
     in.anim_toe = anim_toe;
     in.anim_toe_prev = started ? anim : anim_toe;
@@ -38,6 +38,7 @@ struct Foot {
     in.swing_progress = progress;
     in.other_locked = other_locked;
     in.floor_toe_m = kFloor;
+    in.still_speed_m_s = still_speed;
     started = true;
     anim = anim_toe;
     goal = step_foot_lock(lock, in, params, kDt);
@@ -70,6 +71,47 @@ TEST(FootLock, PlantedFootIsPinnedWhereItWasDrawnAndOnlyComesDown) {
   // Settled on the floor: the 1 cm landing offset decays with a 0.06 s halflife, and 38 frames
   // (0.63 s, over 10 halflives) leave far less than 0.1 mm.
   EXPECT_NEAR(prev.y, kFloor, 1e-4f);
+}
+
+// The clips may plant a foot whose ball still rolls forward off the heel: the lock waits until the
+// ball is at rest (slower than the still speed) or has stopped slowing down, and pins it where it
+// was drawn then, so the drawn foot never stops dead from swing speed.
+TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
+  const float still = 0.5f;  // [m/s]
+  Foot foot;
+  float x = 0.0f;
+  foot.step({x, 0.03f, 0.0f}, false, false, 0.9f, false, still);
+  // Decelerating 4, 3, 2, 1.2, 0.8, 0.4 m/s with the plant on from the first of these frames.
+  const float speeds[] = {4.0f, 3.0f, 2.0f, 1.2f, 0.8f, 0.4f};
+  float drawn_before = 0.0f;
+  for (float v : speeds) {
+    drawn_before = foot.goal.x;
+    x += v * kDt;
+    foot.step({x, kFloor, 0.0f}, true, true, 0.0f, false, still);
+    if (v > still) {
+      EXPECT_NE(foot.lock.state, FootLockState::kLocked) << v;
+      EXPECT_FLOAT_EQ(foot.goal.x, x) << "a foot not yet pinned is where the clip has it";
+    }
+  }
+  ASSERT_EQ(foot.lock.state, FootLockState::kLocked);
+  EXPECT_FLOAT_EQ(foot.goal.x, drawn_before);
+  // Pinned: the clip's toe creeps on, the drawn one stays.
+  for (int f = 0; f < 10; ++f) foot.step({x += 0.001f, kFloor, 0.0f}, true, true, 0.0f, false, still);
+  EXPECT_FLOAT_EQ(foot.goal.x, drawn_before);
+
+  // A ball that never gets slower than the still speed (the crowd walks faster than the clip) is
+  // pinned at its slowest: on the first frame it is no slower than the one before.
+  Foot fast;
+  x = 0.0f;
+  fast.step({x, 0.03f, 0.0f}, false, false, 0.9f, false, still);
+  const float slowing[] = {3.0f, 2.0f, 1.5f, 1.5f};
+  int locked_at = -1;
+  for (int i = 0; i < 4; ++i) {
+    x += slowing[i] * kDt;
+    fast.step({x, kFloor, 0.0f}, true, true, 0.0f, false, still);
+    if (locked_at < 0 && fast.lock.state == FootLockState::kLocked) locked_at = i;
+  }
+  EXPECT_EQ(locked_at, 3);
 }
 
 TEST(FootLock, PlantedBelowTheClipsToeTheFootDoesNotRise) {
