@@ -74,7 +74,7 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
       break;
     }
     case FootLockState::kLocked: {
-      if (!in.hold) {
+      if (!in.hold && !in.other_landing) {
         release_foot_lock(lock, pinned_goal() + lock.offset, glm::vec3(0.0f), in.anim_toe,
                           anim_vel);
         break;

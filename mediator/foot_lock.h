@@ -47,6 +47,10 @@ struct FootLockInput {
   bool hold = false;               // the clips still have weight on it (a lock is kept)
   float swing_progress = 0.0f;     // the clips' swing of this foot, 0 at lift-off, 1 at landing
   bool other_locked = false;       // the other foot is pinned (one foot steps at a time)
+  // Walking, the other foot is coming down or planted but not pinned yet: this one keeps its
+  // weight (its lock) until the other has taken it over, as a trailing foot stays down until the
+  // leading one is flat. (Running has a flight phase: no such wait.)
+  bool other_landing = false;
   float floor_toe_m = 0.0f;        // where planted toes are (library floor) [m]
   // A ball this slow over the ground is at rest (clip analysis's "still": half the travel speed,
   // at least its capture-jitter floor) [m/s]. A plant pins the foot once its ball is at rest, or

@@ -177,6 +177,14 @@ std::vector<std::pair<int, int>> swing_runs(const std::vector<uint8_t>& down, bo
 }
 
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
+  {
+    // A walk has double support: both feet in contact on some frame (a run has a flight instead).
+    const int nf = lc->clip.num_frames;
+    const std::vector<uint8_t> l = contact_frames(lc->analysis, 0, nf, lc->clip.fps, false);
+    const std::vector<uint8_t> r = contact_frames(lc->analysis, 1, nf, lc->clip.fps, false);
+    lc->double_support = false;
+    for (int f = 0; f < nf; ++f) lc->double_support = lc->double_support || (l[f] && r[f]);
+  }
   const Clip& c = lc->clip;
   const int n = c.num_frames;
   std::vector<glm::mat4> model(sk.num_joints());

@@ -38,6 +38,9 @@ struct LocomotionClip {
   std::vector<uint8_t> plant[2];
   std::vector<uint8_t> hold[2];
   std::vector<float> toe_height_m[2];  // toe height above its lowest point
+  // Both feet are in contact on some frame (a walk; a run has a flight phase instead): a foot then
+  // keeps its weight until the other has taken it over.
+  bool double_support = false;
   // How far through its swing each foot is, 0 where it leaves the ground to 1 where it lands
   // (0 while planted).
   std::vector<float> swing_progress[2];

@@ -78,6 +78,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
     plans_.hold[s].assign(capacity, 1.0f);
     plans_.gait_toe_y[s].assign(capacity, 0.0f);
     plans_.swing_progress[s].assign(capacity, 0.0f);
+    plans_.double_support.assign(capacity, 0.0f);
   }
   plans_.phase.assign(capacity, 0.0f);
   plans_.blend_progress.assign(capacity, 1.0f);
@@ -386,7 +387,7 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   // Foot flags are voted by the gait clips alone once they carry a quarter of the blend: a standing
   // clip's "both feet down" would otherwise keep a stepping foot locked while it swings.
   float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
-  float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f};
+  float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, walk = 0.0f;
   const bool gait_votes = gait_w >= 0.25f;
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     const LocomotionClip& clip = lib.clips[lc[k]];
@@ -411,6 +412,7 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     }
     if (gait_votes && !clip.gait) continue;
     vote_w += lw[k];
+    if (clip.double_support) walk += lw[k];
     for (int s = 0; s < 2; ++s) {
       plant[s] += lw[k] * clip.plant[s][f];
       if (!clip.swing_progress[s].empty()) swing[s] += lw[k] * clip.swing_progress[s][f];
@@ -472,6 +474,7 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     pl.swing_progress[s][slot] = swing[s] / std::max(vote_w, 1e-6f);
     pl.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : 0.0f;
   }
+  pl.double_support[slot] = walk / std::max(vote_w, 1e-6f);
   pl.phase[slot] = phase_[slot];
   pl.blend_progress[slot] = fade_[slot];
   pl.standing[slot] = standing;

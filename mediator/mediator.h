@@ -45,6 +45,7 @@ struct AnimationPlans {
   std::vector<float> gait_toe_y[2];
   std::vector<float> gait_weight;        // share of gait clips (not standing) in the blend, 0..1
   std::vector<float> swing_progress[2];  // blended swing progress of each foot, 0..1
+  std::vector<float> double_support;     // share of the voting clips that walk (0..1)
   std::vector<float> phase;              // gait phase [0, 1)
   std::vector<float> blend_progress;     // b: 0 when the chosen clips just changed, 1 when settled
   std::vector<uint8_t> standing;         // 1 when below the stop speed

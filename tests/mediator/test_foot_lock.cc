@@ -114,6 +114,36 @@ TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
   EXPECT_EQ(locked_at, 3);
 }
 
+// Walking, a trailing foot whose clip lifts it while the leading foot is still coming down keeps
+// its lock until the leading one is pinned; then it is let go.
+TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
+  FootLockParams params;
+  FootLock lock;
+  FootLockInput in;
+  in.anim_toe = in.anim_toe_prev = in.drawn_toe_prev = glm::vec3(0.0f, kFloor, 0.0f);
+  in.fresh = true;
+  in.plant = in.hold = true;
+  in.floor_toe_m = kFloor;
+  step_foot_lock(lock, in, params, kDt);
+  ASSERT_EQ(lock.state, FootLockState::kLocked);
+  in.fresh = false;
+  in.plant = in.hold = false;  // the clip lifts the foot
+  in.other_landing = true;     // while the other is not pinned yet
+  for (int f = 0; f < 3; ++f) {
+    in.anim_toe_prev = in.anim_toe;
+    in.anim_toe += glm::vec3(0.01f, 0.005f, 0.0f);
+    const glm::vec3 goal = step_foot_lock(lock, in, params, kDt);
+    EXPECT_EQ(lock.state, FootLockState::kLocked);
+    EXPECT_FLOAT_EQ(goal.x, 0.0f);
+    EXPECT_FLOAT_EQ(goal.y, kFloor);
+  }
+  in.other_landing = false;  // the other foot is pinned: this one goes
+  in.anim_toe_prev = in.anim_toe;
+  in.anim_toe += glm::vec3(0.01f, 0.005f, 0.0f);
+  step_foot_lock(lock, in, params, kDt);
+  EXPECT_EQ(lock.state, FootLockState::kReleasing);
+}
+
 TEST(FootLock, PlantedBelowTheClipsToeTheFootDoesNotRise) {
   // Drawn on the floor, 3 cm below the clip's toe, when it plants (the clip's toe stays 3 cm
   // above the floor): the pinned toe may not go up towards the clip's.
