@@ -145,7 +145,7 @@ Result<std::unique_ptr<CrowdSource>> make_simulation(const Scenario& scenario, i
 
 }  // namespace
 
-CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
+CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed, float body_radius_m) {
   const std::string& cmd = o.command;
   if (o.sim != "social" && o.sim != "detour") {
     fail(cmd, 2, "--sim: expected 'social' or 'detour', got '" + o.sim + "'");
@@ -182,6 +182,7 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
              " exceeds the limit of " + std::to_string(max_cli_agents()) +
              " agents; pass a smaller --agents");
   }
+  apply_body_radius(&*loaded, body_radius_m);
   const Scenario scenario = scale_scenario(*loaded, num_agents);
   src.scenario_name = loaded->name;
   src.agents = num_agents;
