@@ -34,6 +34,10 @@ struct CrowdOptions {
   std::string mode = "apm";
   std::vector<std::string> clips;
   std::string roles;  // JSON role manifest applied to every clip file (empty: roles detected)
+  // Without `clips`: the built-in standing and forward walking clips only (no jog, run, strafe or
+  // backward clips), a small library whose legs cannot run or step sideways, so the mediator has
+  // to feed back what they can deliver (the feedback lesson).
+  bool builtin_walks_only = false;
   std::vector<std::string> sets;
   std::string params_file;
   // Run the crowd round and round: a replayed file starts over after its last sample, a scenario
