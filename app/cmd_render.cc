@@ -108,8 +108,8 @@ void stamp_readouts(const CrowdSession& s, const AnimationLane& lane, int64_t id
   }
   if (overlays.legs) {
     if (const std::optional<LegsReadout> l = legs_readout(s, lane, id)) {
-      std::snprintf(text, sizeof(text), "SIM %.1f M/S - LEGS MAX %.1f - %.0f DEG OFF", l->speed_m_s,
-                    l->legs_max_m_s, std::abs(l->off_deg));
+      std::snprintf(text, sizeof(text), "SIM %.1f M/S, LEGS MAX %.1f", l->speed_m_s,
+                    l->legs_max_m_s);
       stamp_above(text, l->head, camera, view, origin_x, scale, capture, image);
     }
   }

@@ -93,9 +93,8 @@ void DemoApp::draw_overlay_text() {
       if (!l) return;
       const ProjectedPoint p = camera_.project(l->head, view);
       if (!p.in_front || p.pixel.x < 0.0f || p.pixel.x > half) return;
-      std::snprintf(text, sizeof(text),
-                    "simulator %.1f m/s, legs at most %.1f m/s; path %.0f\xc2\xb0 off the legs",
-                    l->speed_m_s, l->legs_max_m_s, std::abs(l->off_deg));
+      std::snprintf(text, sizeof(text), "sim %.1f m/s, legs max %.1f", l->speed_m_s,
+                    l->legs_max_m_s);
       boxed_text(fg, ImVec2(offset_x + p.pixel.x, p.pixel.y - base * 2.2f), text, base * 1.3f,
                  IM_COL32(255, 140, 120, 255), true);
     };

@@ -226,8 +226,9 @@ void DemoApp::panel_view() {
   ImGui::Checkbox("legs vs path", &overlays_.legs);
   help_marker(
       "Selected agent: where its legs walk (blue), where the simulator moves it (green), the "
-      "angle between them filled red and written above the head, and the band within which "
-      "feedback keeps the simulator's velocity (white, turn_feedback_deg)");
+      "angle between them filled red, the band within which feedback keeps the simulator's "
+      "velocity (white, turn_feedback_deg), and above the head the simulator's speed against "
+      "the fastest the legs can go");
   ImGui::TextDisabled("right drag orbit, middle drag pan, wheel zoom, click an agent");
 }
 

@@ -151,7 +151,6 @@ std::optional<LegsReadout> legs_readout(const CrowdSession& session, const Anima
     const glm::vec2 root = plans.root_xz[slot];
     LegsReadout out;
     out.head = glm::vec3(root.x, 2.05f, root.y);
-    out.off_deg = glm::degrees(angle_to(lane.poses->pelvis_heading(slot), std::atan2(v.x, v.y)));
     out.speed_m_s = speed;
     const MediatorParams& params = lane.mediator->params();
     out.band_deg = params.turn_feedback_deg;

@@ -56,7 +56,6 @@ std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const Ani
 // What the legs overlay shows, for its label above the head.
 struct LegsReadout {
   glm::vec3 head{0.0f};    // a point just above the head [m]
-  float off_deg = 0.0f;    // simulator velocity heading - lower-body heading, signed
   float speed_m_s = 0.0f;  // simulator speed
   float band_deg = 0.0f;   // turn_feedback_deg: where feedback (when on) keeps the velocity
   // The fastest the legs can go: the fastest forward clip at the largest playback rate and
