@@ -231,7 +231,11 @@ class GaitPlanner {
       // The elbow bends a little more as the arm swings forward.
       t->elbow[s] = deg(p_.elbow_deg) + 0.35f * std::max(t->arm_forward[s], 0.0f);
     }
-    t->arm_abduction = deg(running() ? 12.0f : 7.0f);
+    // Relaxed arms hang close to the body: the upper arm just clears the trunk and the forearm
+    // comes back in, so the hand passes beside the thigh (runners carry the elbows out a little
+    // more and the hands toward the midline).
+    t->arm_abduction = deg(running() ? 10.0f : 3.0f);
+    t->forearm_abduction = deg(running() ? -15.0f : -6.0f);
   }
 
   // Root height that puts the hip at the leg's reach from the planned ankle with the knee flexed

@@ -46,7 +46,10 @@ struct GaitParams {
   // Cycle fraction (from the same-side contact) at which the arm is furthest back: when the thigh
   // is furthest forward (terminal swing in walking, late swing in running).
   float arm_back_phase = 0.02f;
-  float foot_lateral = 0.85f;         // foot track half-width as a fraction of the hip offset
+  // Foot track half-width as a fraction of the hip joint's lateral offset. Walkers put the feet
+  // closer together than the hip joints (step width 5-15 cm between the feet's contact points,
+  // about 10 cm here), so the legs slant slightly inward and the knees stay over the feet.
+  float foot_lateral = 0.6f;
   float max_leg_extension = 0.9985f;  // idle/side step: hip-ankle distance / leg length
   float idle_duration_s = 6.0f;
 };

@@ -191,13 +191,17 @@ void build_local_pose(const Skeleton& skeleton, const GaitRig& rig, const PoseTa
   for (int s = 0; s < 2; ++s) {
     if (rig.upper_arm[s] < 0) continue;
     const float sign = s == 0 ? 1.0f : -1.0f;
-    const glm::vec3 down(sign * std::sin(t.arm_abduction), -std::cos(t.arm_abduction), 0.0f);
+    auto hanging = [sign](float abduction) {
+      return glm::vec3(sign * std::sin(abduction), -std::cos(abduction), 0.0f);
+    };
     const glm::vec3 fwd(0, 0, 1);
     // Hanging, then swung about the lateral axis in the chest's frame (negative pitch = forward).
     put(rig.upper_arm[s],
-        chest * pitch_q(-t.arm_forward[s]) * frame_rotation(rig.upper_arm_dir[s], fwd, down, fwd));
-    put(rig.forearm[s], chest * pitch_q(-(t.arm_forward[s] + t.elbow[s])) *
-                            frame_rotation(rig.forearm_dir[s], fwd, down, fwd));
+        chest * pitch_q(-t.arm_forward[s]) *
+            frame_rotation(rig.upper_arm_dir[s], fwd, hanging(t.arm_abduction), fwd));
+    put(rig.forearm[s],
+        chest * pitch_q(-(t.arm_forward[s] + t.elbow[s])) *
+            frame_rotation(rig.forearm_dir[s], fwd, hanging(t.forearm_abduction), fwd));
     put(rig.hand[s], world[rig.forearm[s]]);
   }
 

@@ -48,7 +48,8 @@ struct PoseTargets {
   float head_yaw = 0.0f;
   float arm_forward[2] = {0.0f, 0.0f};  // [rad] shoulder flexion (+) / extension (-)
   float elbow[2] = {0.0f, 0.0f};        // [rad] elbow flexion
-  float arm_abduction = 0.0f;           // [rad] arms away from the body
+  float arm_abduction = 0.0f;           // [rad] upper arms away from the body
+  float forearm_abduction = 0.0f;       // [rad] forearms away from the body (< 0: toward it)
 };
 
 glm::quat pelvis_rotation(float yaw, float roll);

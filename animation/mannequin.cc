@@ -34,11 +34,15 @@ enum class Part : uint8_t {
   kToe
 };
 
-const glm::vec3 kSkin(0.62f, 0.62f, 0.64f);
-const glm::vec3 kJointShade(0.50f, 0.50f, 0.53f);
-const glm::vec3 kHeadShade(0.72f, 0.72f, 0.74f);
-const glm::vec3 kShoeShade(0.30f, 0.30f, 0.32f);
+// One neutral grey for the whole body and a darker one for the shoes: the renderer multiplies
+// them by the agent's tint, so each mannequin reads as one colour (no bands at the joints, no
+// differently shaded head that could be taken for another agent's limb).
+const glm::vec3 kSkin(0.64f, 0.64f, 0.64f);
+const glm::vec3 kShoeShade(0.32f, 0.32f, 0.32f);
 constexpr float kPi = 3.14159265358979f;
+// Radii of the widest parts as fractions of stature; body_radius uses the same numbers.
+constexpr float kPelvisRadius = 0.055f;
+constexpr float kUpperArmRadius = 0.033f;
 
 struct Influence {
   int a = 0, b = -1;
@@ -110,7 +114,7 @@ void add_capsule(MeshBuilder* mb, const Capsule& c, int segments) {
   const glm::vec3 v = glm::cross(a, u);
   struct Ring {
     float t, along, radius;
-  };  // t: 0..1 along the bone for weights/colour
+  };  // t: 0..1 along the bone for the weights
   std::vector<Ring> rings;
   constexpr int kCap = 3, kBody = 4;
   for (int i = 0; i <= kCap; ++i) {
@@ -133,8 +137,7 @@ void add_capsule(MeshBuilder* mb, const Capsule& c, int segments) {
     const float t = std::clamp(ring.along / len, 0.0f, 1.0f);
     if (t < 0.25f && c.parent >= 0) inf = {c.joint, c.parent, 0.5f + 2.0f * t};
     if (t > 0.75f && c.child >= 0) inf = {c.joint, c.child, 0.5f + 2.0f * (1.0f - t)};
-    const bool near_joint = t < 0.1f || t > 0.9f;
-    const glm::vec3 color = near_joint ? kJointShade : kSkin;
+    const glm::vec3 color = kSkin;
     const glm::vec3 centre = c.start + a * ring.along;
     const float slope = (c.r0 - c.r1) / len;  // cone normal tilt on the body
     first[r] = 0;
@@ -171,7 +174,7 @@ void add_ellipsoid(MeshBuilder* mb, glm::vec3 centre, glm::vec3 radii, int joint
       const float th = 2.0f * kPi * s / kLon;
       const glm::vec3 unit(std::sin(phi) * std::cos(th), std::cos(phi),
                            std::sin(phi) * std::sin(th));
-      const uint32_t id = mb->vertex(centre + unit * radii, unit / radii, kHeadShade, {joint});
+      const uint32_t id = mb->vertex(centre + unit * radii, unit / radii, kSkin, {joint});
       if (s == 0) first[i] = id;
     }
   }
@@ -272,13 +275,13 @@ std::shared_ptr<const SkinnedMesh> make_mannequin_mesh(const Skeleton& skeleton)
         if (part[j] == Part::kTorso || part[j] == Part::kNeck) {
           c.r0 = 0.065f * h, c.r1 = 0.068f * h, c.lateral_scale = 1.45f;
         } else if (part[j] == Part::kThigh || part[j] == Part::kPelvis) {
-          c.r0 = c.r1 = 0.055f * h;
+          c.r0 = c.r1 = kPelvisRadius * h;
         } else {
           c.r0 = c.r1 = 0.035f * h;
         }
         break;
       case Part::kPelvis:
-        c.r0 = c.r1 = 0.055f * h;
+        c.r0 = c.r1 = kPelvisRadius * h;
         break;
       case Part::kNeck:
         c.r0 = c.r1 = 0.028f * h;
@@ -287,13 +290,13 @@ std::shared_ptr<const SkinnedMesh> make_mannequin_mesh(const Skeleton& skeleton)
         c.r0 = c.r1 = 0.032f * h;
         break;
       case Part::kUpperArm:
-        c.r0 = 0.033f * h, c.r1 = 0.026f * h;
+        c.r0 = kUpperArmRadius * h, c.r1 = 0.026f * h;
         break;
       case Part::kForearm:
         c.r0 = 0.025f * h, c.r1 = 0.018f * h;
         break;
       case Part::kThigh:
-        c.r0 = 0.050f * h, c.r1 = 0.032f * h;
+        c.r0 = 0.045f * h, c.r1 = 0.032f * h;  // a gap between the thighs: two legs, not one
         break;
       case Part::kShank:
         c.r0 = 0.032f * h, c.r1 = 0.021f * h;
@@ -367,6 +370,22 @@ std::shared_ptr<const SkinnedMesh> make_mannequin_mesh(const Skeleton& skeleton)
     mb.box(toes, kShoeShade, {toe});
   }
   return mesh;
+}
+
+float body_radius(const Skeleton& skeleton) {
+  const float h = estimate_stature(skeleton);
+  const std::vector<glm::vec3> pos = gait::rest_positions(skeleton);
+  auto half_apart = [&](int a, int b) {
+    if (a < 0 || b < 0) return -1.0f;
+    return 0.5f * std::hypot(pos[a].x - pos[b].x, pos[a].z - pos[b].z);
+  };
+  float radius = -1.0f;
+  const float shoulders =
+      half_apart(skeleton.role(JointRole::kLeftShoulder), skeleton.role(JointRole::kRightShoulder));
+  if (shoulders >= 0.0f) radius = shoulders + kUpperArmRadius * h;
+  const float hips = half_apart(skeleton.hip(Side::kLeft), skeleton.hip(Side::kRight));
+  if (hips >= 0.0f) radius = std::max(radius, hips + kPelvisRadius * h);
+  return radius > 0.0f ? radius : 0.14f * h;
 }
 
 }  // namespace gk

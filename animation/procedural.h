@@ -23,4 +23,11 @@ ClipSet make_builtin_clip_set(const HumanoidParams& params = {});
 // with smooth skin weights; requires only parents and rest transforms, uses roles when present.
 std::shared_ptr<const SkinnedMesh> make_mannequin_mesh(const Skeleton& skeleton);
 
+// Half-width of the body seen from above [skeleton units], from the rest pose: half the distance
+// between the shoulder joints plus the mannequin's upper-arm radius, or half the distance between
+// the hip joints plus its pelvis radius, whichever is wider (0.25 m for the built-in 1.75 m
+// humanoid). A crowd simulator that keeps agents two such radii apart keeps the drawn bodies from
+// overlapping side by side. Skeletons without those roles: 0.14 of the estimated stature.
+float body_radius(const Skeleton& skeleton);
+
 }  // namespace gk

@@ -28,7 +28,7 @@ GaitParams walk(const char* name, float speed, float stance, float scale) {
   p.pelvis_roll_deg = 3.5f + 1.0f * scale;
   p.trunk_lean_deg = 1.0f + 2.0f * scale;
   p.arm_swing_deg = 11.0f + 9.0f * scale;
-  p.elbow_deg = 15.0f + 13.0f * scale;
+  p.elbow_deg = 20.0f + 12.0f * scale;  // GAIT.md: 20-40 deg, more at higher speed
   return p;
 }
 
@@ -51,7 +51,7 @@ GaitParams run(const char* name, float speed, float cadence, float stance, float
   p.arm_swing_deg = 25.0f + 5.0f * scale;
   p.elbow_deg = 80.0f + 10.0f * scale;
   p.arm_back_phase = 0.78f;
-  p.foot_lateral = 0.6f - 0.15f * scale;  // runners place the feet close to the midline
+  p.foot_lateral = 0.5f - 0.15f * scale;  // runners place the feet closer to the midline
   return p;
 }
 

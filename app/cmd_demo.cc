@@ -26,7 +26,8 @@ void add_demo_command(CLI::App& app) {
   cmd->add_flag("--compare", options->compare, "Start in the naive | apm split screen");
   cmd->add_option("--overlay", options->overlays,
                   "Overlays on at start: velocity, theta, facing, planted, trails, paths, torso "
-                  "(the selected agent's torso fan), all (default: torso; the showcase: trails)");
+                  "(the selected agent's torso fan), legs (the selected agent's legs against its "
+                  "path), all (default: torso; the showcase: trails)");
   cmd->add_option("--lesson", options->lesson,
                   "Open on a lesson: " + lesson_names() +
                       " (scenario, camera, speed, overlays and a split of that one idea off | on)");

@@ -82,22 +82,37 @@ OverlayToggles parse_overlays(const std::vector<std::string>& names) {
   return t;
 }
 
-// The torso fan's label above the followed agent's head, in the half (or whole) image at
-// `origin_x` of width `view.x`.
-void stamp_twist(const CrowdSession& s, const AnimationLane& lane, int64_t id,
-                 const OrbitCamera& camera, glm::ivec2 view, int origin_x, int scale,
-                 FrameCapture* capture, glm::ivec2 image) {
-  const std::optional<TorsoReadout> t = torso_readout(s, lane, id);
-  if (!t) return;
-  const ProjectedPoint p = camera.project(t->head, view);
+// A label centred above `head` [m] in the half (or whole) image at `origin_x` of width `view.x`.
+void stamp_above(const char* text, glm::vec3 head, const OrbitCamera& camera, glm::ivec2 view,
+                 int origin_x, int scale, FrameCapture* capture, glm::ivec2 image) {
+  const ProjectedPoint p = camera.project(head, view);
   if (!p.in_front) return;
-  char text[48];
-  std::snprintf(text, sizeof(text), "TWIST %.0f / LIMIT %.0f DEG", std::abs(t->twist_deg),
-                t->limit_deg);
   const int w = label_width(text, scale);
   const glm::ivec2 at(origin_x + static_cast<int>(p.pixel.x) - w / 2,
                       static_cast<int>(p.pixel.y) - 9 * scale);
   stamp_label(capture->mutable_rgba(), image, at, text, scale);
+}
+
+// The followed agent's readouts above its head: the torso fan's twist, the legs' angle to the
+// simulator's path.
+void stamp_readouts(const CrowdSession& s, const AnimationLane& lane, int64_t id,
+                    const OverlayToggles& overlays, const OrbitCamera& camera, glm::ivec2 view,
+                    int origin_x, int scale, FrameCapture* capture, glm::ivec2 image) {
+  char text[64];
+  if (overlays.torso) {
+    if (const std::optional<TorsoReadout> t = torso_readout(s, lane, id)) {
+      std::snprintf(text, sizeof(text), "TWIST %.0f / LIMIT %.0f DEG", std::abs(t->twist_deg),
+                    t->limit_deg);
+      stamp_above(text, t->head, camera, view, origin_x, scale, capture, image);
+    }
+  }
+  if (overlays.legs) {
+    if (const std::optional<LegsReadout> l = legs_readout(s, lane, id)) {
+      std::snprintf(text, sizeof(text), "SIM %.1f M/S, LEGS MAX %.1f", l->speed_m_s,
+                    l->legs_max_m_s);
+      stamp_above(text, l->head, camera, view, origin_x, scale, capture, image);
+    }
+  }
 }
 
 // Last frame's agents: ids, ground positions and where their hips (0.9 m up) land in the image,
@@ -163,12 +178,16 @@ void run_render(RenderOptions& o) {
     if (!lesson) fail(kCmd, 2, "--lesson: expected " + lesson_names() + ", got '" + o.lesson + "'");
     if (!o.crowd.scenario.empty()) fail(kCmd, 2, "--lesson sets the scenario: drop --scenario");
     o.crowd.scenario = lesson->scenario;
+    if (lesson->walk_clips_only && !o.crowd.clips.empty()) {
+      fail(kCmd, 2, "--lesson " + o.lesson + " uses the built-in forward clips: drop --clips");
+    }
+    o.crowd.builtin_walks_only = lesson->walk_clips_only;
     if (o.crowd.agents.empty() && lesson->agents > 0) o.crowd.agents = std::to_string(lesson->agents);
     o.compare = true;
     const OverlayToggles& t = lesson->overlays;
-    const std::pair<bool, const char*> on[] = {{t.velocity, "velocity"}, {t.theta, "theta"},
-                                               {t.planted, "planted"},   {t.trails, "trails"},
-                                               {t.torso, "torso"}};
+    const std::pair<bool, const char*> on[] = {
+        {t.velocity, "velocity"}, {t.theta, "theta"}, {t.facing, "facing"}, {t.planted, "planted"},
+        {t.trails, "trails"},     {t.paths, "paths"}, {t.torso, "torso"},   {t.legs, "legs"}};
     for (const auto& [set, name] : on) {
       if (set) o.overlays.emplace_back(name);
     }
@@ -185,9 +204,13 @@ void run_render(RenderOptions& o) {
       o.follow.empty() ? -1 : parse_number<int>(kCmd, o.follow, "--follow", 0, 1 << 30);
   // A lesson follows the agent nearest the scene's middle once the crowd has its first frame.
   bool pick_follow = lesson && lesson->follow && follow < 0;
-  if (overlays.torso && follow < 0 && !pick_follow &&
-      o.overlays.end() != std::find(o.overlays.begin(), o.overlays.end(), "torso")) {
-    fail(kCmd, 2, "--overlay torso draws the followed agent's torso fan: add --follow ID");
+  for (const char* selected_only : {"torso", "legs"}) {
+    if (follow < 0 && !pick_follow &&
+        o.overlays.end() != std::find(o.overlays.begin(), o.overlays.end(), selected_only)) {
+      fail(kCmd, 2,
+           std::string("--overlay ") + selected_only +
+               " draws on the followed agent: add --follow ID");
+    }
   }
   const double pull_out_s =
       o.pull_out.empty() ? -1.0 : parse_number<float>(kCmd, o.pull_out, "--pull-out", 0.0f, 1e6f);
@@ -326,14 +349,14 @@ void run_render(RenderOptions& o) {
     if (!drawn.ok()) fail(kCmd, 1, "frame " + std::to_string(f) + ": " + drawn.message());
     scene.context->finish_frame();
     if (Status s = capture.grab(size); !s.ok()) fail(kCmd, 1, s.message());
-    if (overlays.torso && follow >= 0) {
+    if ((overlays.torso || overlays.legs) && follow >= 0) {
       const glm::ivec2 view = split ? glm::ivec2(size.x / 2, size.y) : size;
       const int scale = std::max(2, label_scale - 1);
-      stamp_twist(*session, session->lane(), follow, scene.view->camera(), view,
-                  split ? size.x / 2 : 0, scale, &capture, size);
+      stamp_readouts(*session, session->lane(), follow, overlays, scene.view->camera(), view,
+                     split ? size.x / 2 : 0, scale, &capture, size);
       if (split) {
-        stamp_twist(*session, session->compare_lane(), follow, scene.view->camera(), view, 0,
-                    scale, &capture, size);
+        stamp_readouts(*session, session->compare_lane(), follow, overlays, scene.view->camera(),
+                       view, 0, scale, &capture, size);
       }
     }
     if (split) {
@@ -415,7 +438,8 @@ void add_render_command(CLI::App& app) {
                   "scenario in a 3/4 view)");
   cmd->add_option("--overlay", options->overlays,
                   "Teaching overlays: velocity, theta, facing, planted, trails, paths, torso "
-                  "(the followed agent's torso fan), all");
+                  "(the followed agent's torso fan), legs (the followed agent's legs against its "
+                  "path), all");
   cmd->add_option("--follow", options->follow,
                   "Agent id to follow: a ring at its feet, the camera close on it (--camera then "
                   "sets yaw, pitch and distance)");

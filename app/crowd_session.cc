@@ -43,11 +43,13 @@ std::unique_ptr<CrowdSession> CrowdSession::create(const CrowdOptions& o) {
   const auto seed =
       parse_number<uint64_t>(o.command, o.seed, "--seed", 0, std::numeric_limits<uint64_t>::max());
   std::unique_ptr<CrowdSession> s(new CrowdSession());
-  s->setup_ = make_crowd(o, threads, seed);
+  // The library first: its skeleton gives the simulator the radius of the body that is drawn.
+  s->library_ = std::make_unique<LocomotionLibrary>(load_library(o));
+  s->body_radius_m_ = body_radius(*s->library_->skeleton);
+  s->setup_ = make_crowd(o, threads, seed, s->body_radius_m_);
   s->options_ = o;
   s->threads_ = threads;
   s->seed_ = seed;
-  s->library_ = std::make_unique<LocomotionLibrary>(load_library(o));
   s->params_ = make_params(o, seed);
   // The mediator and pose passes run on TBB: cap its workers at --threads (0 = all cores).
   if (threads > 0) s->thread_cap_.emplace(tbb::global_control::max_allowed_parallelism, threads);
@@ -100,7 +102,7 @@ void CrowdSession::enable_compare(std::function<void(MediatorParams*)> adjust, b
   compare_ = make_lane(p);
   compare_crowd_.reset();
   if (own_crowd) {
-    compare_crowd_.emplace(make_crowd(options_, threads_, seed_));
+    compare_crowd_.emplace(make_crowd(options_, threads_, seed_, body_radius_m_));
   }
 }
 

@@ -84,6 +84,8 @@ class CrowdSession {
   double crowd_time_s() const { return setup_.crowd->time_s(); }
   const CrowdSetup& setup() const { return setup_; }
   const LocomotionLibrary& library() const { return *library_; }
+  // Radius [m] of the drawn body that the simulator keeps between agents (body_radius).
+  float body_radius_m() const { return body_radius_m_; }
   const SkinnedMesh& mesh() const { return *mesh_; }
   int joints() const { return num_joints_; }
   const MediatorParams& params() const { return params_; }
@@ -107,6 +109,7 @@ class CrowdSession {
   CrowdOptions options_;  // to build the compare lane's own crowd
   int threads_ = 1;
   uint64_t seed_ = 1;
+  float body_radius_m_ = 0.0f;  // the simulator's agent radius, from the library's skeleton [m]
   std::optional<CrowdSetup> compare_crowd_;
   AgentFrame compare_frame_;
   std::function<void(MediatorParams*)> compare_adjust_;

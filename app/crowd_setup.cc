@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "animation/clip_library.h"
+#include "animation/gait_generator.h"
 #include "animation/procedural.h"
 #include "app/commands.h"
 #include "common/file_io.h"
@@ -110,6 +111,10 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
                   "apm (the whole mediator; default)");
   cmd->add_option("--clips", o->clips,
                   "BVH/glTF/GLB files or folders forming the clip library (default: built-in)");
+  cmd->add_flag("--walk-clips-only", o->builtin_walks_only,
+                "Without --clips: the built-in standing and forward walking clips only (no jog, "
+                "run, strafe or backward clips): a small library whose legs cannot run or step "
+                "sideways, where feedback has to act");
   cmd->add_option("--roles", o->roles,
                   "JSON role manifest for the --clips files' skeletons, e.g. {\"roles\": "
                   "{\"left_knee\": \"Knee_L\", ...}} (default: roles detected from names and "
@@ -145,7 +150,7 @@ Result<std::unique_ptr<CrowdSource>> make_simulation(const Scenario& scenario, i
 
 }  // namespace
 
-CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
+CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed, float body_radius_m) {
   const std::string& cmd = o.command;
   if (o.sim != "social" && o.sim != "detour") {
     fail(cmd, 2, "--sim: expected 'social' or 'detour', got '" + o.sim + "'");
@@ -182,6 +187,7 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed) {
              " exceeds the limit of " + std::to_string(max_cli_agents()) +
              " agents; pass a smaller --agents");
   }
+  apply_body_radius(&*loaded, body_radius_m);
   const Scenario scenario = scale_scenario(*loaded, num_agents);
   src.scenario_name = loaded->name;
   src.agents = num_agents;
@@ -213,8 +219,24 @@ LocomotionLibrary load_library(const CrowdOptions& o) {
   if (!o.roles.empty() && o.clips.empty()) {
     fail(o.command, 2, "--roles " + o.roles + ": needs --clips (the built-in clips know their roles)");
   }
+  if (o.builtin_walks_only && !o.clips.empty()) {
+    fail(o.command, 2, "--walk-clips-only: applies to the built-in clips; drop --clips");
+  }
   if (o.clips.empty()) {
-    sets.push_back(make_builtin_clip_set());
+    ClipSet builtin = make_builtin_clip_set();
+    if (o.builtin_walks_only) {
+      // builtin_gait_params() lists the clips in the set's order.
+      const std::vector<GaitParams> gaits = builtin_gait_params();
+      std::vector<Clip> walks;
+      for (size_t i = 0; i < builtin.clips.size() && i < gaits.size(); ++i) {
+        const GaitParams& g = gaits[i];
+        const bool forward_walk =
+            g.kind == GaitKind::kWalk && g.direction.z > 0.0f && !g.reverse_time;
+        if (g.kind == GaitKind::kIdle || forward_walk) walks.push_back(std::move(builtin.clips[i]));
+      }
+      builtin.clips = std::move(walks);
+    }
+    sets.push_back(std::move(builtin));
   } else {
     auto files = expand_clip_paths(o.clips);
     if (!files.ok()) fail(o.command, 2, files.message());

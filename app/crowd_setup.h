@@ -34,6 +34,10 @@ struct CrowdOptions {
   std::string mode = "apm";
   std::vector<std::string> clips;
   std::string roles;  // JSON role manifest applied to every clip file (empty: roles detected)
+  // Without `clips`: the built-in standing and forward walking clips only (no jog, run, strafe or
+  // backward clips), a small library whose legs cannot run or step sideways, so the mediator has
+  // to feed back what they can deliver (the feedback lesson).
+  bool builtin_walks_only = false;
   std::vector<std::string> sets;
   std::string params_file;
   // Run the crowd round and round: a replayed file starts over after its last sample, a scenario
@@ -77,7 +81,10 @@ struct CrowdSetup {
 // social-forces simulator's max_agents, so that a bigger crowd is refused before any setup work.
 int max_cli_agents();
 
-CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed);
+// `body_radius_m` > 0: the radius of the drawn body (body_radius of the clip library's skeleton),
+// given to every scenario group whose file sets no "radius"; 0 keeps the scenario's radii.
+CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed,
+                      float body_radius_m = 0.0f);
 // The clip library: the built-in set, or the given files and folders (one clip set per file).
 LocomotionLibrary load_library(const CrowdOptions& o);
 MediatorParams make_params(const CrowdOptions& o, uint64_t seed);

@@ -86,6 +86,21 @@ void DemoApp::draw_overlay_text() {
     label(session_->lane(), split ? half : 0.0f);
     if (split) label(session_->compare_lane(), 0.0f);
   }
+  // The legs' angle to the simulator's path above the selected head, in each half.
+  if (overlays_.legs && selected_id_ >= 0) {
+    auto label = [&](const AnimationLane& lane, float offset_x) {
+      const std::optional<LegsReadout> l = legs_readout(*session_, lane, selected_id_);
+      if (!l) return;
+      const ProjectedPoint p = camera_.project(l->head, view);
+      if (!p.in_front || p.pixel.x < 0.0f || p.pixel.x > half) return;
+      std::snprintf(text, sizeof(text), "sim %.1f m/s, legs max %.1f", l->speed_m_s,
+                    l->legs_max_m_s);
+      boxed_text(fg, ImVec2(offset_x + p.pixel.x, p.pixel.y - base * 2.2f), text, base * 1.3f,
+                 IM_COL32(255, 140, 120, 255), true);
+    };
+    label(session_->lane(), split ? half : 0.0f);
+    if (split) label(session_->compare_lane(), 0.0f);
+  }
   const char* h = hint();
   if (*h) {
     const glm::ivec2 scene = scene_size();

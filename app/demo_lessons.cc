@@ -27,6 +27,11 @@ void DemoApp::start_lesson(const Lesson& lesson) {
   showcase_ = false;
   pick_showcase_ = false;
   crowd_.scenario = lesson.scenario;
+  crowd_.builtin_walks_only = lesson.walk_clips_only;
+  if (lesson.walk_clips_only) {  // the lesson is about the built-in forward clips
+    crowd_.clips.clear();
+    builtin_clips_ = true;
+  }
   crowd_.sim = "social";
   sim_kind_ = 0;
   crowd_.agents = lesson.agents > 0 ? std::to_string(lesson.agents) : "";

@@ -132,6 +132,7 @@ void DemoApp::panel_crowd() {
 
 void DemoApp::apply_crowd() {
   lesson_ = nullptr;  // another crowd: the lesson's text and split no longer apply
+  crowd_.builtin_walks_only = false;  // nor its clip library
   crowd_.sim = sim_kind_ == 1 ? "detour" : "social";
   if (sim_kind_ == 2) {
     crowd_.scenario = replay_path_;
@@ -221,6 +222,13 @@ void DemoApp::panel_view() {
   ImGui::SameLine();
   ImGui::Checkbox("paths", &overlays_.paths);
   help_marker("Root path of the last 4 s");
+  ImGui::SameLine();
+  ImGui::Checkbox("legs vs path", &overlays_.legs);
+  help_marker(
+      "Selected agent: where its legs walk (blue), where the simulator moves it (green), the "
+      "angle between them filled red, the band within which feedback keeps the simulator's "
+      "velocity (white, turn_feedback_deg), and above the head the simulator's speed against "
+      "the fastest the legs can go");
   ImGui::TextDisabled("right drag orbit, middle drag pan, wheel zoom, click an agent");
 }
 

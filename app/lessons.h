@@ -37,6 +37,9 @@ struct Lesson {
   void (*on)(MediatorParams*);
   bool own_crowd;     // the idea changes the simulation (feedback): each half runs its own crowd
   bool rate_plot;     // the panel plots stride length and cadence against speed
+  // Built-in clips without strafe and backward clips (CrowdOptions::builtin_walks_only): the
+  // legs must turn to follow the path, which is where feedback acts.
+  bool walk_clips_only;
   const char* text;   // what to look at, two or three sentences (the window)
   const char* caption;  // the same in a few upper-case words (stamped into rendered frames)
 };

@@ -83,6 +83,19 @@ void torso_fan(CrowdRenderer* r, glm::vec3 ground, float pelvis, float chest, fl
   ribbon(r, c, heading_dir(theta), kRadius_m * 1.15f, 0.015f, kTheta);
 }
 
+// The legs against the path: where the lower body walks (blue), where the simulator moves the
+// agent (green), the difference filled red, and the band feedback keeps the velocity in (white).
+void legs_fan(CrowdRenderer* r, glm::vec3 ground, float pelvis, float velocity, float band_rad) {
+  constexpr float kRadius_m = 0.9f;
+  constexpr glm::vec3 kLegs(0.25f, 0.55f, 1.0f), kPath(0.2f, 0.9f, 0.3f);
+  const glm::vec3 c = ground + glm::vec3(0.0f, 0.02f, 0.0f);
+  sector(r, c, pelvis, angle_to(pelvis, velocity), 0.0f, kRadius_m, {1.0f, 0.2f, 0.15f, 0.5f});
+  sector(r, c, pelvis - band_rad, 2.0f * band_rad, kRadius_m * 1.05f, kRadius_m * 1.12f,
+         glm::vec4(1.0f, 1.0f, 1.0f, 0.8f));
+  ribbon(r, c, heading_dir(pelvis), kRadius_m, 0.025f, kLegs);
+  ribbon(r, c, heading_dir(velocity), kRadius_m * 1.15f, 0.02f, kPath);
+}
+
 glm::vec3 slide_color(float slide_m_s) {
   const float t = std::clamp(slide_m_s / kSkateSpeed_m_s, 0.0f, 1.0f);
   return glm::mix(glm::vec3(0.2f, 0.95f, 0.3f), glm::vec3(1.0f, 0.15f, 0.1f), t);
@@ -92,13 +105,14 @@ glm::vec3 slide_color(float slide_m_s) {
 
 bool enable_overlay(const std::string& n, OverlayToggles* t) {
   if (n == "all") {
-    *t = {true, true, true, true, true, true, true};
+    *t = {true, true, true, true, true, true, true, true};
     return true;
   }
   bool* flags[] = {&t->velocity, &t->theta, &t->facing, &t->planted,
-                   &t->trails,   &t->paths, &t->torso};
-  const char* names[] = {"velocity", "theta", "facing", "planted", "trails", "paths", "torso"};
-  for (int k = 0; k < 7; ++k) {
+                   &t->trails,   &t->paths, &t->torso,  &t->legs};
+  const char* names[] = {"velocity", "theta", "facing", "planted",
+                         "trails",   "paths", "torso",  "legs"};
+  for (int k = 0; k < 8; ++k) {
     if (n == names[k]) return *flags[k] = true;
   }
   return false;
@@ -119,6 +133,32 @@ std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const Ani
     out.twist_deg = glm::degrees(angle_to(pelvis, lane.poses->upper_heading(slot)));
     out.theta_deg = glm::degrees(angle_to(pelvis, frame.thetas[i]));
     out.limit_deg = lane.mediator->params().torsion_limit_deg;
+    return out;
+  }
+  return std::nullopt;
+}
+
+std::optional<LegsReadout> legs_readout(const CrowdSession& session, const AnimationLane& lane,
+                                        int64_t agent_id) {
+  const AgentFrame& frame = session.frame_of(lane);
+  const AnimationPlans& plans = lane.mediator->plans();
+  for (size_t i = 0; i < frame.size(); ++i) {
+    if (frame.ids[i] != agent_id) continue;
+    const int slot = plans.slot_of_agent[i];
+    const glm::vec2 v = frame.velocities[i];
+    const float speed = glm::length(v);
+    if (slot < 0 || speed < lane.mediator->params().stop_speed_m_s) return std::nullopt;
+    const glm::vec2 root = plans.root_xz[slot];
+    LegsReadout out;
+    out.head = glm::vec3(root.x, 2.05f, root.y);
+    out.speed_m_s = speed;
+    const MediatorParams& params = lane.mediator->params();
+    out.band_deg = params.turn_feedback_deg;
+    const LocomotionLibrary& lib = session.library();
+    if (lib.forward_group >= 0 && !lib.groups[lib.forward_group].clips.empty()) {
+      out.legs_max_m_s = lib.clips[lib.groups[lib.forward_group].clips.back()].speed_m_s *
+                         params.max_playback_rate * (1.0f + params.max_stride_warp);
+    }
     return out;
   }
   return std::nullopt;
@@ -252,6 +292,11 @@ void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane
         const int s = static_cast<int>(slot);
         torso_fan(r, ground, poses.pelvis_heading(s), poses.upper_heading(s), frame.thetas[i],
                   glm::radians(lane.mediator->params().torsion_limit_deg));
+      }
+      const glm::vec2 v = frame.velocities[i];
+      if (t.legs && glm::length(v) >= lane.mediator->params().stop_speed_m_s) {
+        legs_fan(r, ground, poses.pelvis_heading(static_cast<int>(slot)), std::atan2(v.x, v.y),
+                 glm::radians(lane.mediator->params().turn_feedback_deg));
       }
       draw_selection_ring(ground, r);
     }

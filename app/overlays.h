@@ -28,14 +28,20 @@ struct OverlayToggles {
   // The selected agent's torso fan: pelvis (blue), chest (orange) and theta (yellow) directions,
   // the twist filled between pelvis and chest, and the torsion limit as a white arc.
   bool torso = false;
-  bool any() const { return velocity || theta || facing || planted || trails || paths || torso; }
+  // The selected agent's legs against its path: the lower body's heading (blue) and the
+  // simulator's velocity (green) on the ground, the angle between them filled (red), and the band
+  // within which feedback keeps the velocity (turn_feedback_deg, white).
+  bool legs = false;
+  bool any() const {
+    return velocity || theta || facing || planted || trails || paths || torso || legs;
+  }
 };
 
 // Overlay names of the CLI (`--overlay`): velocity, theta, facing, planted, trails, paths, torso
 // and all. Sets the toggle and returns true, or false for an unknown name.
 bool enable_overlay(const std::string& name, OverlayToggles* toggles);
 inline constexpr const char* kOverlayNames =
-    "velocity, theta, facing, planted, trails, paths, torso or all";
+    "velocity, theta, facing, planted, trails, paths, torso, legs or all";
 
 // What the torso fan shows, for its label above the head.
 struct TorsoReadout {
@@ -46,6 +52,19 @@ struct TorsoReadout {
 };
 std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
                                           int64_t agent_id);
+
+// What the legs overlay shows, for its label above the head.
+struct LegsReadout {
+  glm::vec3 head{0.0f};    // a point just above the head [m]
+  float speed_m_s = 0.0f;  // simulator speed
+  float band_deg = 0.0f;   // turn_feedback_deg: where feedback (when on) keeps the velocity
+  // The fastest the legs can go: the fastest forward clip at the largest playback rate and
+  // stride warp (beyond it, feedback when on slows the simulator down) [m/s].
+  float legs_max_m_s = 0.0f;
+};
+// nullopt when the agent is not in the lane's frame or stands (no direction to compare).
+std::optional<LegsReadout> legs_readout(const CrowdSession& session, const AnimationLane& lane,
+                                        int64_t agent_id);
 
 // The selected agent's ring (magenta, 0.5 m) around `ground` (its root, just above the floor).
 void draw_selection_ring(const glm::vec3& ground, CrowdRenderer* renderer);

@@ -255,6 +255,7 @@ class Parser {
       GK_RETURN_IF_ERROR(speed(v["speed"], join(path, "speed"), &out->speed));
     GK_RETURN_IF_ERROR(
         number_field(v, "radius", path, {0.0f, 1.0f, true, "a number in (0, 1]"}, &out->radius_m));
+    out->radius_given = v.contains("radius");
     GK_RETURN_IF_ERROR(number_field(v, "goal_radius", path, kPositive, &out->goal_radius_m));
     return number_field(v, "attention", path, kUnit, &out->attention);
   }

@@ -75,6 +75,9 @@ struct AgentGroup {
   bool remove_at_goal = false;  // at the end of a non-looping chain: vanish (else stop and stay)
   SpeedDistribution speed;
   float radius_m = 0.25f;      // body radius [m] [Limit: (0, 1]]
+  // The file set "radius". Groups without it take the drawn body's radius when the app knows the
+  // clip library (apply_body_radius).
+  bool radius_given = false;
   float goal_radius_m = 0.5f;  // a waypoint counts as reached within this distance [m] [> 0]
   float attention = 1.0f;      // probability that an agent looks at attention targets [0, 1]
 };
@@ -132,6 +135,11 @@ float scale_factor_for(const Scenario& scenario, int num_agents);
 // multiplied by scale_factor_for(scenario, num_agents) about (0, 0). Body and goal radii, look
 // radii and speeds keep their values.
 Scenario scale_scenario(const Scenario& scenario, int num_agents);
+
+// Gives every group whose file did not set "radius" the body radius `radius_m` [m] (the
+// half-width of the body that is drawn, so that where the simulator keeps two agents apart their
+// bodies do not overlap). radius_m outside (0, 1] leaves the scenario as it is.
+void apply_body_radius(Scenario* scenario, float radius_m);
 
 // Draws `num_agents` agents for `seed` (same seed, same agents). Fails, naming the group, when
 // the spawn areas cannot hold them at max_spawn_density (call scale_scenario first) or when

@@ -244,6 +244,13 @@ Scenario scale_scenario(const Scenario& scenario, int num_agents) {
   return f == 1.0f ? scenario : scaled(scenario, f);
 }
 
+void apply_body_radius(Scenario* scenario, float radius_m) {
+  if (!(radius_m > 0.0f && radius_m <= 1.0f)) return;
+  for (AgentGroup& g : scenario->groups) {
+    if (!g.radius_given) g.radius_m = radius_m;
+  }
+}
+
 Result<ScenarioAgents> expand_agents(const Scenario& s, int num_agents, uint64_t seed) {
   if (num_agents < 0 || num_agents > kMaxScenarioAgents) {
     return Status::Error(s.source + ": " + std::to_string(num_agents) +

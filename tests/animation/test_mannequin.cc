@@ -10,6 +10,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "animation/bvh_loader.h"
+#include "animation/gait_generator.h"
 #include "animation/pose_jobs.h"
 #include "animation/procedural.h"
 #include "tests/test_data.h"
@@ -98,6 +99,65 @@ TEST(Mannequin, BuiltinMeshIsValidStandsOnTheGroundAndHasTheStature) {
   }
 }
 
+// One colour per agent: the renderer multiplies the mesh colours by the agent's tint, so the mesh
+// must be greys only, and one grey for the whole body (the shoes may be darker). Two differently
+// shaded halves or bands would read as two agents' limbs.
+TEST(Mannequin, BuiltinMeshIsOneGreyWithDarkerShoes) {
+  const auto skel = make_humanoid_skeleton();
+  const auto mesh = make_mannequin_mesh(*skel);
+  std::vector<glm::vec3> distinct;
+  for (const glm::vec3& c : mesh->colors) {
+    EXPECT_FLOAT_EQ(c.x, c.y);
+    EXPECT_FLOAT_EQ(c.y, c.z);
+    if (std::find(distinct.begin(), distinct.end(), c) == distinct.end()) distinct.push_back(c);
+  }
+  EXPECT_LE(distinct.size(), 2u) << "body and shoes";
+  // Everything above the ankles is the body's colour.
+  glm::vec3 body(-1.0f);
+  for (size_t v = 0; v < mesh->positions.size(); ++v) {
+    if (mesh->positions[v].y < 0.1f * kHeight) continue;
+    if (body.x < 0.0f) body = mesh->colors[v];
+    EXPECT_EQ(mesh->colors[v], body) << "vertex " << v;
+  }
+}
+
+// body_radius is the half-width of the body that is drawn: the skinned mannequin, walking with the
+// built-in clips, reaches that far to each side of its pelvis and not much farther or less far.
+TEST(Mannequin, BodyRadiusIsTheDrawnHalfWidth) {
+  const ClipSet set = make_builtin_clip_set();
+  const Skeleton& s = *set.skeleton;
+  const float radius = body_radius(s);
+  EXPECT_NEAR(radius, 0.25f, 0.05f) << "a 1.75 m adult is about 0.5 m across the shoulders";
+  const int hips = s.role(JointRole::kHips);
+  std::vector<glm::mat4> model(s.num_joints()), palette(s.num_joints());
+  float widest = 0.0f;
+  for (const Clip& c : set.clips) {
+    if (c.name.rfind("walk", 0) != 0) continue;
+    for (int f = 0; f < c.num_frames; ++f) {
+      LocalToModelJob fk;
+      fk.skeleton = &s;
+      fk.rotations = {c.frame_rotations(f), size_t(s.num_joints())};
+      fk.translations = {c.frame_translations(f), size_t(s.num_joints())};
+      fk.out_model = model;
+      ASSERT_TRUE(fk.validate());
+      fk.run();
+      SkinningPaletteJob skin{model, set.mesh->inverse_bind, palette};
+      ASSERT_TRUE(skin.validate());
+      skin.run();
+      const glm::mat4 to_pelvis = glm::inverse(model[hips]);
+      for (size_t v = 0; v < set.mesh->positions.size(); ++v) {
+        glm::vec4 p(0.0f);
+        for (int k = 0; k < 4; ++k) {
+          p += set.mesh->weights[v][k] *
+               (palette[set.mesh->joints[v][k]] * glm::vec4(set.mesh->positions[v], 1.0f));
+        }
+        widest = std::max(widest, std::abs((to_pelvis * p).x));
+      }
+    }
+  }
+  EXPECT_NEAR(widest, radius, 0.1f * radius) << "widest point of the walking mannequin";
+}
+
 TEST(Mannequin, WorksForASkeletonWithoutRoles) {
   Skeleton s;
   auto add = [&](const char* name, int parent, glm::vec3 offset) {
@@ -127,6 +187,10 @@ TEST(Mannequin, WorksForTheMocapSkeletons) {
     const Skeleton& s = *loaded->skeleton;
     const auto mesh = make_mannequin_mesh(s);
     expect_valid_mannequin(s, *mesh, file);
+    // The mocap skeletons are in centimetres or inches: the radius scales with the stature.
+    const float h = estimate_stature(s);
+    EXPECT_GT(body_radius(s), 0.1f * h) << file;
+    EXPECT_LT(body_radius(s), 0.2f * h) << file;
     EXPECT_GE(mesh->num_triangles(), 1500) << file;
     EXPECT_LE(mesh->num_triangles(), 7000) << file;
   }

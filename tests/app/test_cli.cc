@@ -160,6 +160,30 @@ TEST(Cli, MetricRecomputedFromTheJointDumpEqualsTheReport) {
   EXPECT_EQ(rep["joints"].get<int>(), 25);
 }
 
+// The feedback lesson's claim, measured: runners (the rush scenario) with only the built-in walks
+// played at most at their own speed. Without feedback the simulator keeps them above what the
+// legs can do and the support feet slide; with it they slow to the fastest walk and stand still.
+TEST(Cli, FeedbackSlowsRunnersToWhatWalkingLegsCanDo) {
+  const std::string dir = test::scratch_dir("cli");
+  double speed[2], max_speed[2], slide[2];
+  for (int on = 0; on < 2; ++on) {
+    const std::string json = dir + "/rush_feedback_" + std::to_string(on) + ".json";
+    const CommandResult r =
+        run("bench --scenario rush --frames 360 --walk-clips-only --set max_playback_rate=1 "
+            "--set max_stride_warp=0 --set feedback=" +
+            std::string(on ? "true" : "false") + " --json " + json);
+    ASSERT_EQ(r.code, 0) << r.out;
+    const nlohmann::json rep = read_json(json);
+    speed[on] = rep["crowd"]["mean_speed_m_s"].get<double>();
+    max_speed[on] = rep["crowd"]["max_speed_m_s"].get<double>();
+    slide[on] = rep["metrics"]["support_slide_cm_s"].get<double>();
+  }
+  // walk_fast is generated at 1.8 m/s (animation/procedural_clips.cc): the legs' maximum here.
+  EXPECT_LE(max_speed[1], 1.8 * 1.02);
+  EXPECT_GT(speed[0], 1.8 * 1.2) << "without feedback the runners keep running";
+  EXPECT_LT(slide[1], 0.25 * slide[0]) << "feet slide without feedback, stand with it";
+}
+
 TEST(Cli, BenchReplaysRealTrajectories) {
   GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
   const std::string json = test::scratch_dir("cli") + "/zara.json";

@@ -252,5 +252,33 @@ TEST(Scenario, WallShapesBecomeSegments) {
   EXPECT_GE(s->bounds_max.y, 10.0f);
 }
 
+
+// A group without "radius" takes the drawn body's radius; one that sets it keeps it; the expanded
+// agents carry the result.
+TEST(Scenario, BodyRadiusFillsOnlyGroupsWithoutARadius) {
+  auto s = parse_scenario(R"({"groups": [
+      {"spawn": {"rect": {"min": [-5, -5], "max": [5, 5]}}, "waypoints": [{"point": [0, 9]}]},
+      {"spawn": {"rect": {"min": [-5, 6], "max": [5, 9]}}, "waypoints": [{"point": [0, -9]}],
+       "radius": 0.2}]})",
+                          "radius.json");
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_FALSE(s->groups[0].radius_given);
+  EXPECT_TRUE(s->groups[1].radius_given);
+  Scenario body = *s;
+  apply_body_radius(&body, 0.31f);
+  EXPECT_FLOAT_EQ(body.groups[0].radius_m, 0.31f);
+  EXPECT_FLOAT_EQ(body.groups[1].radius_m, 0.2f);
+  auto a = expand_agents(body, 10, 3);
+  ASSERT_TRUE(a.ok()) << a.message();
+  for (size_t i = 0; i < a->size(); ++i) {
+    EXPECT_FLOAT_EQ(a->radii_m[i], a->group[i] == 0 ? 0.31f : 0.2f);
+  }
+  // Out of (0, 1]: nothing changes.
+  Scenario same = *s;
+  apply_body_radius(&same, 0.0f);
+  apply_body_radius(&same, 1.5f);
+  EXPECT_FLOAT_EQ(same.groups[0].radius_m, s->groups[0].radius_m);
+}
+
 }  // namespace
 }  // namespace gk
