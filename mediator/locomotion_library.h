@@ -88,6 +88,9 @@ struct LocomotionLibrary {
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;
   std::vector<TakeReport> takes;  // takes with root motion, as segmented
+  // Clips of the given sets that are not in the library, each "name (file): why" (a standing
+  // clip without contacts, a name that says it is no locomotion, ...): reported, never silent.
+  std::vector<std::string> left_out;
   std::vector<std::string> clip_names() const;
   bool has_direction_clips() const { return groups.size() > 1; }
 };
