@@ -83,6 +83,7 @@ nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAna
       {"loops", clip.loops},
       {"scale", set.scale_m_per_unit},
       {"scale_reason", set.scale_reason},
+      {"rig", set.rig_reason},
       {"in_place", a.in_place},
       {"native_speed_m_s", a.native_speed_m_s},
       {"direction_deg", a.direction_rad * 180.0f / std::numbers::pi_v<float>},
@@ -104,6 +105,9 @@ void print_text(const nlohmann::json& j) {
               j["joints"].get<int>(), j["scale"].get<double>(),
               j["scale_reason"].get<std::string>().c_str(),
               j["loops"].get<bool>() ? ", loops" : "");
+  if (!j["rig"].get<std::string>().empty()) {
+    std::printf("  rig: %s\n", j["rig"].get<std::string>().c_str());
+  }
   std::printf("  speed %.3f m/s%s, direction %.1f deg, cycle %.3f-%.3f s\n",
               j["native_speed_m_s"].get<double>(),
               j["in_place"].get<bool>() ? " (in place: from stance foot)" : "",
@@ -201,8 +205,9 @@ int run_analyze(const AnalyzeOptions& opt) {
     if (!set.skeleton->has_locomotion_roles()) {
       std::fprintf(stderr,
                    "gaitkeeper analyze-clip: %s: skeleton lacks hips/leg joints the analysis needs "
-                   "(give a role manifest with --roles FILE.json)\n",
-                   set.source.c_str());
+                   "(no joint found for %s); %s\n",
+                   set.source.c_str(), missing_locomotion_roles(*set.skeleton).c_str(),
+                   role_manifest_hint().c_str());
       ++failures;
       continue;
     }
