@@ -83,6 +83,7 @@ class CrowdSession {
   CrowdSource& crowd() { return *setup_.crowd; }
   double crowd_time_s() const { return setup_.crowd->time_s(); }
   const CrowdSetup& setup() const { return setup_; }
+  const CrowdOptions& options() const { return options_; }  // what the session was built from
   const LocomotionLibrary& library() const { return *library_; }
   const SkinnedMesh& mesh() const { return *mesh_; }
   int joints() const { return num_joints_; }
