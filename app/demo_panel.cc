@@ -206,9 +206,9 @@ void DemoApp::panel_clips() {
   }
   ImGui::EndTable();
   // What the given files hold that the library does not use, and why (never dropped silently).
-  const auto& left_out = session_->library().left_out;
+  const std::vector<std::string> left_out = describe_left_out(session_->library());
   if (!left_out.empty()) {
-    ImGui::Text("left out (%zu):", left_out.size());
+    ImGui::Text("left out (%zu clips):", session_->library().left_out.size());
     ImGui::PushTextWrapPos(0.0f);
     for (const std::string& l : left_out) ImGui::TextDisabled("%s", l.c_str());
     ImGui::PopTextWrapPos();

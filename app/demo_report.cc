@@ -88,7 +88,7 @@ void DemoApp::write_report(const std::string& path) const {
       {"panel", {panel_rect_.x, panel_rect_.y, panel_rect_.z, panel_rect_.w}},
       {"status", status_},
       {"clips", clips},
-      {"clips_left_out", session_->library().left_out},
+      {"clips_left_out", describe_left_out(session_->library())},
       {"roles", session_->options().roles},
       {"agents", agents},
       {"exhibits", exhibits}};

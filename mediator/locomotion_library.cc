@@ -403,6 +403,22 @@ std::vector<std::string> describe_takes(const LocomotionLibrary& library) {
   return out;
 }
 
+std::vector<std::string> describe_left_out(const LocomotionLibrary& library) {
+  std::vector<std::string> lines;
+  std::vector<std::pair<std::string, std::string>> keys;  // (file, why) in order of appearance
+  for (const LocomotionLibrary::LeftOut& l : library.left_out) {
+    const auto key = std::make_pair(l.file, l.why);
+    const size_t k = std::find(keys.begin(), keys.end(), key) - keys.begin();
+    if (k == keys.size()) {
+      keys.push_back(key);
+      lines.push_back(l.file + ": " + l.why + ": " + l.clip);
+    } else {
+      lines[k] += ", " + l.clip;
+    }
+  }
+  return lines;
+}
+
 std::vector<std::string> LocomotionLibrary::clip_names() const {
   std::vector<std::string> names;
   for (const LocomotionClip& c : clips) names.push_back(c.clip.name);
@@ -552,7 +568,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   // Every clip that does not make it into the library is named with the reason, never dropped
   // silently.
   auto leave_out = [&](const Clip& c, const std::string& why) {
-    lib.left_out.push_back(c.name + " (" + c.source + "): " + why);
+    lib.left_out.push_back({c.name, c.source, why});
   };
   std::vector<LocomotionClip> idles;
   struct Fallback {
@@ -666,6 +682,9 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         report.clips.push_back(still.name);
         add(std::move(still), nullptr);
       }
+      if (report.clips.empty() && seg.cycles.empty()) {
+        leave_out(clip, "a take with no stride to loop and no standing stretch (see its segments)");
+      }
       lib.takes.push_back(std::move(report));
     }
   }
@@ -678,7 +697,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   }
   if (lib.clips.empty()) {
     std::string why;
-    for (const std::string& l : lib.left_out) why += "; " + l;
+    for (const std::string& l : describe_left_out(lib)) why += "; " + l;
     return Status::Error(std::string("clip library: no walking or running clip found (a clip ") +
                          "needs a travel speed of 0.25-12 m/s and foot contacts on both feet)" +
                          why);
