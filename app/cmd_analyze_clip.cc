@@ -1,7 +1,8 @@
 // `gaitkeeper analyze-clip FILE... [--scale S] [--roles F] [--plot F.png] [--json]`: loads
-// BVH/glTF clips (or the built-in set, FILE = "builtin") and prints each clip's analysis (speed,
-// direction, cycle, foot contacts, the foot-slide floor of METRICS.md) and, for a take, its
-// segments, strides, the loops cut from it and its problems; --plot draws them.
+// BVH/glTF clips (or the built-in set, FILE = "builtin") and prints each clip's unit scale, the
+// IK-style feet re-parented at load (if any), its analysis (speed, direction, cycle, foot
+// contacts, the foot-slide floor of METRICS.md) and, for a take, its segments, strides, the loops
+// cut from it and its problems; --plot draws them.
 
 #include <cmath>
 #include <cstdio>
@@ -254,8 +255,9 @@ void add_analyze_clip_command(CLI::App& app) {
   auto opt = std::make_shared<AnalyzeOptions>();
   CLI::App* cmd = app.add_subcommand(
       "analyze-clip",
-      "Analyse clips: native speed and direction, gait cycle, foot contacts, foot-slide floor; "
-      "a take's segments (idle, start, steady, turn, stop) and the loops cut from it.");
+      "Analyse clips: unit scale, IK-style feet re-parented under the shins, native speed and "
+      "direction, gait cycle, foot contacts, foot-slide floor; a take's segments (idle, start, "
+      "steady, turn, stop) and the loops cut from it.");
   cmd->add_option("files", opt->files,
                   "BVH, glTF or GLB files, folders of them, or 'builtin' for the built-in set")
       ->required();
