@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/quaternion.hpp>
 
+#include "animation/bvh_loader.h"
 #include "animation/gltf_loader.h"
 #include "animation/ik_rig.h"
 #include "animation/mesh.h"
@@ -167,6 +168,76 @@ TEST(IkRig, MeaninglessNamesInInchesNeedTheManifest) {
   EXPECT_LT(worst_joint_error(*set, rig), 1e-3f);
   for (size_t c = 0; c < set->clips.size(); ++c) {
     EXPECT_LT(worst_vertex_error(*set, rig, c, 11), 1e-3f) << set->clips[c].name;
+  }
+}
+
+// A BVH whose feet hang from the hips (listed before the legs, so the joints must be reordered),
+// in centimetres. In the second frame the left thigh swings 30 deg forward: the file's foot does
+// not follow it (it is its own joint under the hips), and re-parented under the shin it still
+// must not, while the whole body moves 5 cm forward.
+TEST(IkRig, BvhFeetUnderTheHipsKeepTheirPlaceOnEveryFrame) {
+  std::string text =
+      "HIERARCHY\nROOT Hips\n{\nOFFSET 0 95 0\n"
+      "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n";
+  for (const char* side : {"Left", "Right"}) {
+    const std::string x = side[0] == 'L' ? "10" : "-10";
+    text += std::string("JOINT ") + side + "Foot\n{\nOFFSET " + x +
+            " -89 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nJOINT " + side +
+            "ToeBase\n{\nOFFSET 0 -4 12\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+            "End Site\n{\nOFFSET 0 0 5\n}\n}\n}\n";
+  }
+  text +=
+      "JOINT Spine\n{\nOFFSET 0 10 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+      "JOINT Neck\n{\nOFFSET 0 40 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+      "JOINT Head\n{\nOFFSET 0 10 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+      "End Site\n{\nOFFSET 0 10 0\n}\n}\n}\n}\n";
+  for (const char* side : {"Left", "Right"}) {
+    const std::string x = side[0] == 'L' ? "10" : "-10";
+    text += std::string("JOINT ") + side + "UpLeg\n{\nOFFSET " + x +
+            " -5 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nJOINT " + side +
+            "Leg\n{\nOFFSET 0 -42 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+            "End Site\n{\nOFFSET 0 -42 0\n}\n}\n}\n";
+  }
+  // Channels in file order: hips (6), feet and toes (12), spine, neck, head (9), legs (12).
+  std::string frame0 = "0 95 0 0 0 0", frame1 = "0 95 5 0 0 0";
+  for (int k = 0; k < 33; ++k) {
+    frame0 += " 0";
+    frame1 += k == 22 ? " -30" : " 0";  // LeftUpLeg's Xrotation
+  }
+  text += "}\nMOTION\nFrames: 2\nFrame Time: 0.0333333\n" + frame0 + "\n" + frame1 + "\n";
+  Result<ClipSet> set = parse_bvh(text, "ik_feet.bvh");
+  ASSERT_TRUE(set.ok()) << set.message();
+  EXPECT_FLOAT_EQ(set->scale_m_per_unit, 0.01f) << set->scale_reason;
+  const Skeleton& s = *set->skeleton;
+  ASSERT_TRUE(s.has_locomotion_roles()) << missing_locomotion_roles(s);
+  EXPECT_EQ(role_joint(s, JointRole::kLeftAnkle), "LeftFoot");
+  EXPECT_EQ(s.parents[s.ankle(Side::kLeft)], s.knee(Side::kLeft));
+  EXPECT_EQ(s.parents[s.toe(Side::kLeft)], s.ankle(Side::kLeft));
+  EXPECT_GT(s.ankle(Side::kLeft), s.knee(Side::kLeft));
+  EXPECT_NE(set->rig_reason.find("LeftFoot under LeftLeg (was under Hips)"), std::string::npos)
+      << set->rig_reason;
+  // End sites travel with their joints.
+  EXPECT_NEAR(glm::distance(s.end_sites[s.toe(Side::kLeft)], glm::vec3(0, 0, 0.05f)), 0.0f, 1e-6f);
+  const Clip& c = set->clips[0];
+  ASSERT_EQ(c.num_frames, 2);
+  for (int f = 0; f < 2; ++f) {
+    const auto m = model_pose(s, c.frame_rotations(f), c.frame_translations(f));
+    const glm::vec3 hips(0.0f, 0.95f, 0.05f * f);
+    EXPECT_LT(
+        glm::distance(glm::vec3(m[s.ankle(Side::kLeft)][3]), hips + glm::vec3(0.1f, -0.89f, 0)),
+        1e-5f)
+        << f;
+    EXPECT_LT(
+        glm::distance(glm::vec3(m[s.toe(Side::kLeft)][3]), hips + glm::vec3(0.1f, -0.93f, 0.12f)),
+        1e-5f)
+        << f;
+    // The knee does swing: forward and up by the thigh's 30 deg.
+    const glm::vec3 knee = glm::vec3(m[s.knee(Side::kLeft)][3]) - hips;
+    const float a = f == 0 ? 0.0f : glm::radians(30.0f);
+    EXPECT_LT(
+        glm::distance(knee, glm::vec3(0.1f, -0.05f - 0.42f * std::cos(a), 0.42f * std::sin(a))),
+        1e-5f)
+        << f;
   }
 }
 
