@@ -589,7 +589,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     fill_contacts_and_heights(&lc, sk);
     const bool both_feet =
         !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
-    char speed[32];
+    char speed[64];  // "%.2f" of any float fits
     std::snprintf(speed, sizeof(speed), "%.2f m/s", lc.speed_m_s);
     const std::string no_contacts =
         std::string("clip analysis finds no foot contact on ") +

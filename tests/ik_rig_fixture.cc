@@ -138,7 +138,7 @@ IkRig make_ik_rig(const IkRigOptions& o) {
   std::vector<std::string> node_names(num_nodes);
   node_names[0] = o.known_names ? "root" : "bone_00";
   for (int j = 0; j < nh; ++j) {
-    char buf[16];
+    char buf[24];
     std::snprintf(buf, sizeof(buf), "bone_%02d", j + 1);
     std::string name = buf;
     if (o.known_names) {
