@@ -411,8 +411,9 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
   a.direction_rad =
       a.native_speed_m_s > 0.0f ? wrap_angle(heading_of(travel_vel) - heading_of(facing)) : 0.0f;
 
-  // Gait cycle: the loop for looping clips; otherwise the first full stride of a foot, from one
-  // contact start to its next (a contact cut by the take's first frame starts no stride).
+  // Gait cycle: the loop for looping clips of one stride (one stride of a loop of several);
+  // otherwise the first full stride of a foot, from one contact start to its next (a contact cut
+  // by the take's first frame starts no stride).
   float period = a.duration_s;
   if (!clip.loops) {
     for (int s : {0, 1}) {
@@ -427,7 +428,11 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
       }
     }
   }
-  if (clip.loops && a.contacts[0].size() >= 2) period = a.duration_s / a.contacts[0].size();
+  if (clip.loops && a.contacts[0].size() >= 2) {
+    // A loop of several strides: the cycle is one of them, from a left contact's start.
+    period = a.duration_s / a.contacts[0].size();
+    a.cycle = {a.contacts[0][0].start_s, a.contacts[0][0].start_s + period};
+  }
   a.phase = gait_phase(a, period, clip.loops);
 
   // Floor: the clip played at 60 Hz with its own root motion (in-place clips with the inferred

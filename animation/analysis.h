@@ -43,7 +43,7 @@ struct ClipAnalysis {
   bool in_place = false;  // no horizontal root motion: speed inferred from the stance foot
   float native_speed_m_s = 0.0f;
   float direction_rad = 0.0f;  // travel direction relative to the character's facing (0 = forward)
-  TimeInterval cycle;          // one gait cycle (loop points)
+  TimeInterval cycle;          // one gait cycle (the loop points of a one-stride loop)
   std::vector<TimeInterval> contacts[2];  // [Side] foot contact intervals, in clip time
   // Per frame: gait phase in [0, 1), 0 at the left foot's contact start (linear between contacts).
   std::vector<float> phase;

@@ -7,6 +7,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "animation/ik_rig.h"
 #include "animation/loader_internal.h"
 #include "animation/text_scanner.h"
 #include "common/file_io.h"
@@ -415,6 +416,10 @@ Result<ClipSet> parse_bvh(std::string_view text, const std::string& source_name,
   GK_RETURN_IF_ERROR(validate_clip(*clip, *skeleton));
   set.clips.push_back(std::move(clip).value());
   set.skeleton = std::move(skeleton);
+  if (std::string moved = attach_ik_feet(&set); !moved.empty()) {
+    set.rig_reason = "IK-style feet attached to the legs: " + moved;
+    GK_RETURN_IF_ERROR(validate_skeleton(*set.skeleton, source_name));
+  }
   return set;
 }
 

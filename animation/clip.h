@@ -24,8 +24,8 @@ struct Clip {
   // [frame * num_joints + joint]
   std::vector<glm::quat> rotations;
   std::vector<glm::vec3> translations;
-  // Loop clips are sampled with wrap-around: frame num_frames-1 is followed by frame 0 (loaders drop
-  // a final frame that duplicates the first).
+  // Loop clips are sampled with wrap-around: frame num_frames-1 is followed by frame 0 (loaders
+  // drop a final frame that duplicates the first).
   bool loops = true;
 
   float duration_s() const {
@@ -49,6 +49,8 @@ struct ClipSet {
   std::shared_ptr<const SkinnedMesh> mesh;  // null when the source has none (BVH)
   float scale_m_per_unit = 1.0f;            // the unit scale applied while loading
   std::string scale_reason;                 // how it was chosen ("detected: centimetres", ...)
+  // IK-style feet re-parented under their shins at load (attach_ik_feet), or empty.
+  std::string rig_reason;
   std::string source;
 };
 

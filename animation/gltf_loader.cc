@@ -15,6 +15,7 @@
 #include <glm/gtx/quaternion.hpp>
 
 #include "animation/gltf_internal.h"
+#include "animation/ik_rig.h"
 #include "animation/loader_internal.h"
 #include "animation/mesh.h"
 #include "common/file_io.h"
@@ -435,6 +436,10 @@ Result<ClipSet> clips_from_model(const tinygltf::Model& model, const std::string
   }
   set.mesh = *mesh;
   set.skeleton = build->skeleton;
+  if (std::string moved = attach_ik_feet(&set); !moved.empty()) {
+    set.rig_reason = "IK-style feet attached to the legs: " + moved;
+    GK_RETURN_IF_ERROR(validate_skeleton(*set.skeleton, path));
+  }
   return set;
 }
 

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 
+#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include "common/file_io.h"
@@ -15,6 +16,12 @@
 
 namespace gk {
 namespace {
+
+// The roles the mediator needs for locomotion (has_locomotion_roles).
+constexpr JointRole kLocomotionRoles[] = {
+    JointRole::kHips,       JointRole::kChest,   JointRole::kLeftHip,  JointRole::kLeftKnee,
+    JointRole::kLeftAnkle,  JointRole::kLeftToe, JointRole::kRightHip, JointRole::kRightKnee,
+    JointRole::kRightAnkle, JointRole::kRightToe};
 
 constexpr uint64_t kMaxManifestBytes = 1u << 20;  // a manifest names a few dozen joints
 
@@ -127,6 +134,18 @@ NameInfo classify(std::string_view raw) {
     info.part = part_of_base(compact(base), true);
     return info;
   }
+  // CamelCase with a bare capital side letter at the end (RobotExpressive's "UpperLegL",
+  // "FootR"): only when the rest is a known leg or arm word, so that "Ball" is not read as sided.
+  const char last = raw.empty() ? '\0' : raw.back();
+  if ((last == 'L' || last == 'R') && raw.size() > 2 &&
+      std::islower(static_cast<unsigned char>(raw[raw.size() - 2]))) {
+    const Part p = part_of_base(compact(n.substr(0, n.size() - 1)), true);
+    if (p != Part::kNone) {
+      info.part = p;
+      info.side = last == 'L' ? NameSide::kLeft : NameSide::kRight;
+      return info;
+    }
+  }
   const std::string c = compact(n);
   info.part = part_of_base(c, false);
   // ASF style ("lfemur", "rtibia"): a bare l/r prefix counts only when the rest is a known part,
@@ -138,7 +157,28 @@ NameInfo classify(std::string_view raw) {
       info.side = c[0] == 'l' ? NameSide::kLeft : NameSide::kRight;
     }
   }
+  // A leg word without a side ("Thigh", "Foot.001"): the side comes from where the joint sits
+  // (resolve_sides_by_geometry).
+  if (info.part == Part::kNone) {
+    std::string word = c;
+    while (!word.empty() && std::isdigit(static_cast<unsigned char>(word.back()))) word.pop_back();
+    const Part p = part_of_base(word, true);
+    if (p == Part::kThigh || p == Part::kShin || p == Part::kFoot || p == Part::kToe) info.part = p;
+  }
   return info;
+}
+
+// Rest-pose positions in model space: the geometry that pairs IK-style feet with their legs.
+std::vector<glm::vec3> rest_positions(const Skeleton& s) {
+  const int n = s.num_joints();
+  std::vector<glm::vec3> pos(n);
+  std::vector<glm::quat> rot(n);
+  for (int j = 0; j < n; ++j) {
+    const int p = s.parents[j];
+    rot[j] = p < 0 ? s.rest_rotations[j] : rot[p] * s.rest_rotations[j];
+    pos[j] = p < 0 ? s.rest_translations[j] : pos[p] + rot[p] * s.rest_translations[j];
+  }
+  return pos;
 }
 
 bool is_descendant(const Skeleton& s, int joint, int ancestor) {
@@ -181,7 +221,40 @@ int common_ancestor(const Skeleton& s, int a, int b) {
 
 void set_role(Skeleton* s, JointRole r, int joint) { s->roles[static_cast<int>(r)] = joint; }
 
-void detect_leg(Skeleton* s, const std::vector<NameInfo>& info, NameSide side, int hips) {
+bool is_descendant_or_self(const Skeleton& s, int joint, int ancestor) {
+  return joint == ancestor || is_descendant(s, joint, ancestor);
+}
+
+// An IK-style rig's foot (or toe) is not below its shin (or foot): it hangs from the root or the
+// hips and follows an IK target. Among the joints named `part` on `side` that are not below
+// `upper` (the knee, or the ankle for a toe) nor above the thigh, the one that sits where the
+// bone below `upper` would end: lower than `upper` by a plausible bone length (0.4 to 2 thigh
+// lengths for a shin, up to one shin length for a foot), nearest to it horizontally.
+int ik_style_joint(const Skeleton& s, const std::vector<NameInfo>& info,
+                   const std::vector<glm::vec3>& pos, Part part, NameSide side, int thigh,
+                   int upper, float bone_m) {
+  int best = -1;
+  float best_d = 0.0f;
+  for (int j = 0; j < s.num_joints(); ++j) {
+    if (info[j].part != part || info[j].side != side) continue;
+    if (is_descendant_or_self(s, j, upper) || is_descendant_or_self(s, thigh, j)) continue;
+    const glm::vec3 d = pos[j] - pos[upper];
+    const float len = glm::length(d);
+    const bool plausible = part == Part::kFoot
+                               ? len > 0.4f * bone_m && len < 2.0f * bone_m && -d.y > 0.5f * len
+                               : len > 0.05f * bone_m && len < bone_m && d.y < 0.1f * bone_m;
+    if (!plausible) continue;
+    const float horizontal = std::hypot(d.x, d.z);
+    if (best < 0 || horizontal < best_d) {
+      best = j;
+      best_d = horizontal;
+    }
+  }
+  return best;
+}
+
+void detect_leg(Skeleton* s, const std::vector<NameInfo>& info, const std::vector<glm::vec3>& pos,
+                NameSide side, int hips) {
   const bool left = side == NameSide::kLeft;
   int hip = -1, knee = -1, ankle = -1, toe = -1;
   // Prefer the thigh candidate that has a complete chain below it (some rigs name a pelvis-side
@@ -197,7 +270,15 @@ void detect_leg(Skeleton* s, const std::vector<NameInfo>& info, NameSide side, i
       ankle = a;
     }
   }
+  if (knee >= 0 && ankle < 0) {
+    ankle = ik_style_joint(*s, info, pos, Part::kFoot, side, hip, knee,
+                           glm::length(pos[knee] - pos[hip]));
+  }
   if (ankle >= 0) toe = nearest_below(*s, info, Part::kToe, side, ankle);
+  if (ankle >= 0 && toe < 0) {
+    toe = ik_style_joint(*s, info, pos, Part::kToe, side, hip, ankle,
+                         glm::length(pos[ankle] - pos[knee]));
+  }
   set_role(s, left ? JointRole::kLeftHip : JointRole::kRightHip, hip);
   set_role(s, left ? JointRole::kLeftKnee : JointRole::kRightKnee, knee);
   set_role(s, left ? JointRole::kLeftAnkle : JointRole::kRightAnkle, ankle);
@@ -241,13 +322,29 @@ int Skeleton::find(std::string_view name) const {
 }
 
 bool Skeleton::has_locomotion_roles() const {
-  for (JointRole r :
-       {JointRole::kHips, JointRole::kChest, JointRole::kLeftHip, JointRole::kLeftKnee,
-        JointRole::kLeftAnkle, JointRole::kLeftToe, JointRole::kRightHip, JointRole::kRightKnee,
-        JointRole::kRightAnkle, JointRole::kRightToe}) {
+  for (JointRole r : kLocomotionRoles) {
     if (!has(r)) return false;
   }
   return true;
+}
+
+std::string missing_locomotion_roles(const Skeleton& s) {
+  std::string out;
+  for (JointRole r : kLocomotionRoles) {
+    if (!s.has(r)) out += (out.empty() ? "" : ", ") + std::string(joint_role_name(r));
+  }
+  return out;
+}
+
+std::string role_manifest_hint() {
+  return "roles are found from joint names (LeftUpLeg/LeftLeg/LeftFoot/LeftToeBase, "
+         "thigh_l/calf_l/foot_l/ball_l, UpperLeg.L, lfemur/ltibia/lfoot/ltoes, ...), and a foot "
+         "parented to the root is matched to the knee above it; otherwise give a role manifest "
+         "with --roles FILE.json (in the demo panel: Crowd > roles...) naming this skeleton's "
+         "joint for each role: {\"roles\": {\"hips\": \"...\", \"chest\": \"...\", "
+         "\"left_hip\": \"...\", \"left_knee\": \"...\", \"left_ankle\": \"...\", "
+         "\"left_toe\": \"...\", \"right_hip\": \"...\", \"right_knee\": \"...\", "
+         "\"right_ankle\": \"...\", \"right_toe\": \"...\"}}";
 }
 
 void detect_joint_roles(Skeleton* s) {
@@ -258,8 +355,23 @@ void detect_joint_roles(Skeleton* s) {
   for (int j = 0; j < n; ++j) info[j] = classify(s->names[j]);
 
   int hips = nearest_below(*s, info, Part::kHips, NameSide::kNone, -1);
-  detect_leg(s, info, NameSide::kLeft, hips);
-  detect_leg(s, info, NameSide::kRight, hips);
+  const std::vector<glm::vec3> pos = rest_positions(*s);
+  // Leg words without a side take the side they stand on (left at +x, the rest pose facing +z),
+  // relative to the hips or, without them, the middle of the skeleton.
+  const float mid_x = hips >= 0 ? pos[hips].x : 0.0f;
+  for (int j = 0; j < n; ++j) {
+    if (info[j].side != NameSide::kNone || info[j].part == Part::kNone ||
+        info[j].part == Part::kHips || info[j].part == Part::kSpine ||
+        info[j].part == Part::kNeck || info[j].part == Part::kHead) {
+      continue;
+    }
+    const float x = pos[j].x - mid_x;
+    if (std::abs(x) > 1e-4f * (1.0f + std::abs(pos[j].y))) {
+      info[j].side = x > 0.0f ? NameSide::kLeft : NameSide::kRight;
+    }
+  }
+  detect_leg(s, info, pos, NameSide::kLeft, hips);
+  detect_leg(s, info, pos, NameSide::kRight, hips);
   // Without a hips name, the pelvis is where the two legs meet.
   if (hips < 0 && s->has(JointRole::kLeftHip) && s->has(JointRole::kRightHip)) {
     hips = common_ancestor(*s, s->role(JointRole::kLeftHip), s->role(JointRole::kRightHip));

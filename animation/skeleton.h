@@ -68,23 +68,38 @@ struct Skeleton {
   bool has(JointRole r) const { return role(r) >= 0; }
   int find(std::string_view name) const;  // -1 if absent
   // Hip, knee, ankle, toe of one side.
-  int hip(Side s) const { return role(s == Side::kLeft ? JointRole::kLeftHip : JointRole::kRightHip); }
+  int hip(Side s) const {
+    return role(s == Side::kLeft ? JointRole::kLeftHip : JointRole::kRightHip);
+  }
   int knee(Side s) const {
     return role(s == Side::kLeft ? JointRole::kLeftKnee : JointRole::kRightKnee);
   }
   int ankle(Side s) const {
     return role(s == Side::kLeft ? JointRole::kLeftAnkle : JointRole::kRightAnkle);
   }
-  int toe(Side s) const { return role(s == Side::kLeft ? JointRole::kLeftToe : JointRole::kRightToe); }
+  int toe(Side s) const {
+    return role(s == Side::kLeft ? JointRole::kLeftToe : JointRole::kRightToe);
+  }
   // True when every role the mediator needs for locomotion (hips, chest, both legs) is present.
   bool has_locomotion_roles() const;
 };
 
 // Fills roles and spine_chain from the joint names, recognising CMU/cgspeed (LeftUpLeg/LeftLeg/
 // LeftFoot/LeftToeBase and LeftHip/LeftKnee/LeftAnkle/LeftToe), Rigify (DEF-thigh.L), Mixamo
-// (mixamorig:LeftUpLeg) and plain (l_hip, left_knee) names, with topology checks (a knee must be
-// below its hip, ...). Unrecognised roles stay -1.
+// (mixamorig:LeftUpLeg), Unreal (thigh_l/calf_l/foot_l/ball_l), ASF (lfemur/ltibia/lfoot/ltoes),
+// RobotExpressive (UpperLegL) and plain (l_hip, left_knee) names, with topology checks (a knee
+// must be below its hip, ...). A leg word without a side ("Foot.001") takes the side it stands on
+// in the rest pose (left at +x). IK-style rigs, whose feet (or toes) are not below the shins (or
+// feet) but hang from the root or the hips, are matched by the rest pose: the foot is the
+// same-side foot joint that sits a plausible shin length below the knee, nearest under it (the
+// loaders then re-parent it, attach_ik_feet). Unrecognised roles stay -1.
 void detect_joint_roles(Skeleton* skeleton);
+
+// The locomotion roles (those of has_locomotion_roles) the skeleton lacks, comma-separated
+// ("left_ankle, right_ankle"); empty when it has them all.
+std::string missing_locomotion_roles(const Skeleton& skeleton);
+// For error messages: how roles are found and how to give them (--roles FILE.json, its format).
+std::string role_manifest_hint();
 
 // Overrides roles from a JSON manifest: {"roles": {"left_knee": "Knee_L", ...}}. Errors name the
 // manifest file and the field.

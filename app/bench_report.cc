@@ -63,6 +63,7 @@ json to_json(const BenchReport& r) {
       {"joints", or_null(r.joints)},
       {"clips", r.clips},
       {"takes", r.takes},
+      {"left_out", r.left_out},
       {"timing_ms", timing},
       {"us_per_agent", or_null(r.us_per_agent)},
       {"metrics", r.metrics ? *r.metrics : json(nullptr)},
@@ -130,6 +131,7 @@ std::string summary(const BenchReport& r) {
     s += "  mode " + r.mode + ", " + std::to_string(r.joints.value_or(0)) + " joints, clips:";
     for (const std::string& c : r.clips) s += " " + c;
     for (const std::string& t : r.takes) s += "\n  take " + t;
+    for (const std::string& l : r.left_out) s += "\n  left out: " + l;
     s += "\n  foot slide " + num(m["foot_slide_cm_s"], 2) + " cm/s (p95 " +
          num(m["foot_slide_p95_cm_s"], 2) + ", clips' floor " + num(m["foot_slide_floor_cm_s"], 2) +
          "), skate ratio " + num(m["skate_ratio"], 4) + ", drift " +

@@ -92,6 +92,8 @@ struct BenchReport {
   // What the library made of takes with root motion: "take: segments; problems" (doubtful
   // analysis is reported, never silent).
   std::vector<std::string> takes;
+  // Clips of the given files that are not in the library: "file: why: clip, clip, ...".
+  std::vector<std::string> left_out;
   std::array<std::optional<TimingStat>, kNumStages> timing_ms;
   std::optional<double> us_per_agent;     // median total / agents * 1000
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists

@@ -1,7 +1,8 @@
 // `gaitkeeper analyze-clip FILE... [--scale S] [--roles F] [--plot F.png] [--json]`: loads
-// BVH/glTF clips (or the built-in set, FILE = "builtin") and prints each clip's analysis (speed,
-// direction, cycle, foot contacts, the foot-slide floor of METRICS.md) and, for a take, its
-// segments, strides, the loops cut from it and its problems; --plot draws them.
+// BVH/glTF clips (or the built-in set, FILE = "builtin") and prints each clip's unit scale, the
+// IK-style feet re-parented at load (if any), its analysis (speed, direction, cycle, foot
+// contacts, the foot-slide floor of METRICS.md) and, for a take, its segments, strides, the loops
+// cut from it and its problems; --plot draws them.
 
 #include <cmath>
 #include <cstdio>
@@ -83,6 +84,7 @@ nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAna
       {"loops", clip.loops},
       {"scale", set.scale_m_per_unit},
       {"scale_reason", set.scale_reason},
+      {"rig", set.rig_reason},
       {"in_place", a.in_place},
       {"native_speed_m_s", a.native_speed_m_s},
       {"direction_deg", a.direction_rad * 180.0f / std::numbers::pi_v<float>},
@@ -104,6 +106,9 @@ void print_text(const nlohmann::json& j) {
               j["joints"].get<int>(), j["scale"].get<double>(),
               j["scale_reason"].get<std::string>().c_str(),
               j["loops"].get<bool>() ? ", loops" : "");
+  if (!j["rig"].get<std::string>().empty()) {
+    std::printf("  rig: %s\n", j["rig"].get<std::string>().c_str());
+  }
   std::printf("  speed %.3f m/s%s, direction %.1f deg, cycle %.3f-%.3f s\n",
               j["native_speed_m_s"].get<double>(),
               j["in_place"].get<bool>() ? " (in place: from stance foot)" : "",
@@ -201,8 +206,9 @@ int run_analyze(const AnalyzeOptions& opt) {
     if (!set.skeleton->has_locomotion_roles()) {
       std::fprintf(stderr,
                    "gaitkeeper analyze-clip: %s: skeleton lacks hips/leg joints the analysis needs "
-                   "(give a role manifest with --roles FILE.json)\n",
-                   set.source.c_str());
+                   "(no joint found for %s); %s\n",
+                   set.source.c_str(), missing_locomotion_roles(*set.skeleton).c_str(),
+                   role_manifest_hint().c_str());
       ++failures;
       continue;
     }
@@ -249,8 +255,9 @@ void add_analyze_clip_command(CLI::App& app) {
   auto opt = std::make_shared<AnalyzeOptions>();
   CLI::App* cmd = app.add_subcommand(
       "analyze-clip",
-      "Analyse clips: native speed and direction, gait cycle, foot contacts, foot-slide floor; "
-      "a take's segments (idle, start, steady, turn, stop) and the loops cut from it.");
+      "Analyse clips: unit scale, IK-style feet re-parented under the shins, native speed and "
+      "direction, gait cycle, foot contacts, foot-slide floor; a take's segments (idle, start, "
+      "steady, turn, stop) and the loops cut from it.");
   cmd->add_option("files", opt->files,
                   "BVH, glTF or GLB files, folders of them, or 'builtin' for the built-in set")
       ->required();

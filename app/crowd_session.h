@@ -83,6 +83,7 @@ class CrowdSession {
   CrowdSource& crowd() { return *setup_.crowd; }
   double crowd_time_s() const { return setup_.crowd->time_s(); }
   const CrowdSetup& setup() const { return setup_; }
+  const CrowdOptions& options() const { return options_; }  // what the session was built from
   const LocomotionLibrary& library() const { return *library_; }
   // Radius [m] of the drawn body that the simulator keeps between agents (body_radius).
   float body_radius_m() const { return body_radius_m_; }

@@ -51,6 +51,7 @@ DemoApp::DemoApp(DemoOptions options) : options_(std::move(options)) {
   if (crowd_.sim == "detour") sim_kind_ = 1;
   builtin_clips_ = crowd_.clips.empty();
   if (!builtin_clips_) clip_path_ = crowd_.clips.front();
+  roles_path_ = crowd_.roles;
   agents_edited_ = !crowd_.agents.empty();
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(scenario_dir(), ec)) {

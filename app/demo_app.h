@@ -150,6 +150,7 @@ class DemoApp {
   std::string replay_path_;
   bool builtin_clips_ = true;
   std::string clip_path_;
+  std::string roles_path_;  // role manifest for the clip files (--roles); empty: detected
   int agents_ = 0;
   bool agents_edited_ = false;  // the count typed in the panel overrides the scenario's default
   std::string params_path_ = "gaitkeeper_params.json";

@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -20,7 +21,13 @@ constexpr float kPanelWidth = static_cast<float>(kPanelWidth_px);
 constexpr float kLabelColumn = 172.0f;  // [px] plain-language labels left, widgets right
 constexpr const char* kSims[] = {"social forces", "DetourCrowd", "replay a trajectory file"};
 constexpr const char* kModes[] = {"naive", "rate", "apm"};
-enum BrowseFor : int { kBrowseClips, kBrowseTrajectory, kBrowseLoadParams, kBrowseSaveParams };
+enum BrowseFor : int {
+  kBrowseClips,
+  kBrowseTrajectory,
+  kBrowseLoadParams,
+  kBrowseSaveParams,
+  kBrowseRoles
+};
 
 void help_marker(const char* text) {
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
@@ -114,6 +121,29 @@ void DemoApp::panel_crowd() {
     }
     ImGui::SameLine();
     if (ImGui::Button("load clips")) changed = true;
+    // The role manifest in use (the session's, not a choice that failed to load).
+    const std::string& in_use = session_->options().roles;
+    row("roles");
+    ImGui::TextUnformatted(in_use.empty()
+                               ? "from joint names"
+                               : std::filesystem::path(in_use).filename().string().c_str());
+    help_marker(
+        "Which joint is the hips, each knee, ankle, toe...: found from the joint names (and, for "
+        "feet parented to the root, from the rest pose), or given by a role manifest (--roles), "
+        "a JSON file {\"roles\": {\"left_knee\": \"Knee_L\", ...}}. A library whose legs "
+        "cannot be found says which roles are missing.");
+    if (ImGui::Button("roles...")) {
+      browser_.open("Role manifest",
+                    roles_path_.empty() ? browse_start(clip_path_, "clips") : roles_path_,
+                    {".json"}, FileBrowser::Mode::kOpen, false, kBrowseRoles);
+    }
+    if (!roles_path_.empty()) {
+      ImGui::SameLine();
+      if (ImGui::Button("no manifest")) {
+        roles_path_.clear();
+        changed = true;
+      }
+    }
   }
   row("animation");
   int mode = static_cast<int>(session_->params().mode);
@@ -143,6 +173,7 @@ void DemoApp::apply_crowd() {
   }
   crowd_.clips.clear();
   if (!builtin_clips_) crowd_.clips.push_back(clip_path_);
+  crowd_.roles = builtin_clips_ ? "" : roles_path_;
   // Keep the current parameters (and mode) across the rebuild.
   crowd_.sets.clear();
   crowd_.params_file.clear();
@@ -175,6 +206,14 @@ void DemoApp::panel_clips() {
     ImGui::Text("%.2f", c.cycle_s);
   }
   ImGui::EndTable();
+  // What the given files hold that the library does not use, and why (never dropped silently).
+  const std::vector<std::string> left_out = describe_left_out(session_->library());
+  if (!left_out.empty()) {
+    ImGui::Text("left out (%zu clips):", session_->library().left_out.size());
+    ImGui::PushTextWrapPos(0.0f);
+    for (const std::string& l : left_out) ImGui::TextDisabled("%s", l.c_str());
+    ImGui::PopTextWrapPos();
+  }
 }
 
 void DemoApp::panel_view() {
@@ -391,6 +430,10 @@ void DemoApp::handle_browser() {
     case kBrowseTrajectory:
       replay_path_ = path;
       apply_crowd();
+      break;
+    case kBrowseRoles:
+      roles_path_ = path;
+      if (!clip_path_.empty()) apply_crowd();  // else it applies when the clips are chosen
       break;
     case kBrowseSaveParams: {
       params_path_ = path;

@@ -87,6 +87,8 @@ void DemoApp::write_report(const std::string& path) const {
       {"panel", {panel_rect_.x, panel_rect_.y, panel_rect_.z, panel_rect_.w}},
       {"status", status_},
       {"clips", clips},
+      {"clips_left_out", describe_left_out(session_->library())},
+      {"roles", session_->options().roles},
       {"agents", agents},
       {"exhibits", exhibits}};
   std::ofstream out(path);

@@ -411,6 +411,22 @@ std::vector<std::string> describe_takes(const LocomotionLibrary& library) {
   return out;
 }
 
+std::vector<std::string> describe_left_out(const LocomotionLibrary& library) {
+  std::vector<std::string> lines;
+  std::vector<std::pair<std::string, std::string>> keys;  // (file, why) in order of appearance
+  for (const LocomotionLibrary::LeftOut& l : library.left_out) {
+    const auto key = std::make_pair(l.file, l.why);
+    const size_t k = std::find(keys.begin(), keys.end(), key) - keys.begin();
+    if (k == keys.size()) {
+      keys.push_back(key);
+      lines.push_back(l.file + ": " + l.why + ": " + l.clip);
+    } else {
+      lines[k] += ", " + l.clip;
+    }
+  }
+  return lines;
+}
+
 std::vector<std::string> LocomotionLibrary::clip_names() const {
   std::vector<std::string> names;
   for (const LocomotionClip& c : clips) names.push_back(c.clip.name);
@@ -548,15 +564,20 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   lib.mesh = sets[0].mesh;
   const Skeleton& sk = *lib.skeleton;
   if (!sk.has_locomotion_roles()) {
-    return Status::Error(
-        sets[0].source +
-        ": skeleton lacks the hips/leg joints the mediator needs (hips, hip, knee, "
-        "ankle and toe on both sides); give a role manifest with --roles FILE.json");
+    return Status::Error(sets[0].source +
+                         ": skeleton lacks the hips/leg joints the mediator needs (no joint found "
+                         "for " +
+                         missing_locomotion_roles(sk) + "); " + role_manifest_hint());
   }
   const std::vector<glm::mat4> rest = rest_model(sk);
   for (int s = 0; s < 2; ++s) lib.leg_length_m[s] = leg_length(sk, rest, static_cast<Side>(s));
   const float dst_leg = 0.5f * (lib.leg_length_m[0] + lib.leg_length_m[1]);
 
+  // Every clip that does not make it into the library is named with the reason, never dropped
+  // silently.
+  auto leave_out = [&](const Clip& c, const std::string& why) {
+    lib.left_out.push_back({c.name, c.source, why});
+  };
   std::vector<LocomotionClip> idles;
   struct Fallback {
     Clip loop, take;
@@ -576,31 +597,56 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     fill_contacts_and_heights(&lc, sk);
     const bool both_feet =
         !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
+    char speed[64];  // "%.2f" of any float fits
+    std::snprintf(speed, sizeof(speed), "%.2f m/s", lc.speed_m_s);
+    const std::string no_contacts =
+        std::string("clip analysis finds no foot contact on ") +
+        (lc.analysis.contacts[0].empty() && lc.analysis.contacts[1].empty()
+             ? "either foot"
+             : (lc.analysis.contacts[0].empty() ? "the left foot" : "the right foot"));
     if (lc.speed_m_s < kMinGaitSpeed) {
-      if (both_feet) {
-        lc.cycle_s = lc.clip.duration_s();
-        idles.push_back(std::move(lc));
+      if (!both_feet) {
+        return leave_out(lc.clip, "standing (" + std::string(speed) + ") but " + no_contacts);
       }
+      lc.cycle_s = lc.clip.duration_s();
+      idles.push_back(std::move(lc));
       return;
     }
-    if (lc.speed_m_s > kMaxGaitSpeed || !both_feet) return;
+    if (lc.speed_m_s > kMaxGaitSpeed) {
+      return leave_out(lc.clip, "travels at " + std::string(speed) + ", faster than any gait");
+    }
+    if (!both_feet) {
+      return leave_out(lc.clip, "travels at " + std::string(speed) + " but " + no_contacts);
+    }
     lc.gait = true;
     lc.cycle_start_s = lc.analysis.contacts[0][0].start_s;
     if (!lc.clip.loops) lc.cycle_start_s = lc.analysis.cycle.start_s;
-    if (!build_phase_table(&lc)) return;
+    if (!build_phase_table(&lc)) {
+      return leave_out(lc.clip, "no full gait cycle (the contacts do not make one stride)");
+    }
     lib.clips.push_back(std::move(lc));
   };
   for (const ClipSet& set : sets) {
     const Skeleton& src = *set.skeleton;
     if (!src.has_locomotion_roles()) {
-      return Status::Error(set.source + ": skeleton lacks the hips/leg joints the mediator needs");
+      return Status::Error(set.source + ": cannot retarget its clips onto the library skeleton (" +
+                           sets[0].source + "): its skeleton lacks the hips/leg joints (no joint " +
+                           "found for " + missing_locomotion_roles(src) + "); " +
+                           role_manifest_hint());
     }
     const std::vector<glm::mat4> src_rest = rest_model(src);
     const float src_leg =
         0.5f * (leg_length(src, src_rest, Side::kLeft) + leg_length(src, src_rest, Side::kRight));
     const bool same = set.skeleton == lib.skeleton;
     for (const Clip& original : set.clips) {
-      if (name_excluded(original.name) || original.num_frames < 2) continue;
+      if (name_excluded(original.name)) {
+        leave_out(original, "its name says it is not walking or running");
+        continue;
+      }
+      if (original.num_frames < 2) {
+        leave_out(original, "a single frame");
+        continue;
+      }
       Clip clip = same ? original : retarget_clip(original, src, sk, dst_leg / src_leg);
       const ClipAnalysis whole = analyze_clip(clip, sk);
       if (clip.loops || whole.in_place) {
@@ -644,16 +690,25 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         report.clips.push_back(still.name);
         add(std::move(still), nullptr);
       }
+      if (report.clips.empty() && seg.cycles.empty()) {
+        leave_out(clip, "a take with no stride to loop and no standing stretch (see its segments)");
+      }
       lib.takes.push_back(std::move(report));
     }
   }
   if (lib.clips.empty()) {
     for (Fallback& f : fallbacks) add(std::move(f.loop), &f.take);
+  } else {
+    for (const Fallback& f : fallbacks) {
+      leave_out(f.loop, "a stride that speeds up or slows down, not needed beside steady cycles");
+    }
   }
   if (lib.clips.empty()) {
-    return Status::Error(
-        "clip library: no walking or running clip found (a clip needs a travel speed "
-        "of 0.25-12 m/s and foot contacts on both feet)");
+    std::string why;
+    for (const std::string& l : describe_left_out(lib)) why += "; " + l;
+    return Status::Error(std::string("clip library: no walking or running clip found (a clip ") +
+                         "needs a travel speed of 0.25-12 m/s and foot contacts on both feet)" +
+                         why);
   }
   // Direction groups: forward, left, right, backward, or their own direction.
   for (int i = 0; i < static_cast<int>(lib.clips.size()); ++i) {
@@ -697,6 +752,11 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     };
     auto calm = std::min_element(idles.begin(), idles.end(),
                                  [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
+    for (const LocomotionClip& other : idles) {
+      if (&other != &*calm) {
+        leave_out(other.clip, "standing; the library stands with " + calm->clip.name);
+      }
+    }
     lib.clips.push_back(std::move(*calm));
   } else {
     lib.clips.push_back(

@@ -91,9 +91,18 @@ struct LocomotionLibrary {
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;
   std::vector<TakeReport> takes;  // takes with root motion, as segmented
+  // Clips of the given sets that are not in the library and why (a standing clip without
+  // contacts, a name that says it is no locomotion, ...): reported, never silent.
+  struct LeftOut {
+    std::string clip, file, why;
+  };
+  std::vector<LeftOut> left_out;
   std::vector<std::string> clip_names() const;
   bool has_direction_clips() const { return groups.size() > 1; }
 };
+
+// The clips left out, one line per file and reason: "file: why: clip, clip, ...".
+std::vector<std::string> describe_left_out(const LocomotionLibrary& library);
 
 // One line per segmented take: its segments (kind and span), the clips cut from it, and its problems.
 std::vector<std::string> describe_takes(const LocomotionLibrary& library);

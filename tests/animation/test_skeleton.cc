@@ -168,6 +168,93 @@ TEST(SkeletonRoles, TopologyRejectsMisplacedJoints) {
   EXPECT_FALSE(s.has_locomotion_roles());
 }
 
+// A skeleton from (name, parent name, rest offset [m]) in topological order.
+struct PlacedJoint {
+  std::string name, parent;
+  glm::vec3 offset;
+};
+Skeleton placed_skeleton(const std::vector<PlacedJoint>& joints) {
+  Skeleton s;
+  for (const PlacedJoint& j : joints) {
+    s.names.push_back(j.name);
+    s.parents.push_back(static_cast<int16_t>(j.parent.empty() ? -1 : s.find(j.parent)));
+    s.rest_translations.push_back(j.offset);
+    s.rest_rotations.push_back(glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+  }
+  return s;
+}
+
+// A robot whose feet hang from the root (an IK-style rig): each foot is the same-side foot joint
+// a shin length below its knee, not the IK helper at hip height nor the other side's foot.
+TEST(SkeletonRoles, IkStyleFeetAreMatchedToTheKneeAboveThem) {
+  std::vector<PlacedJoint> j = {{"root", "", {0, 0, 0}},
+                                {"pelvis", "root", {0, 0.95f, 0}},
+                                {"spine_01", "pelvis", {0, 0.1f, 0}},
+                                {"spine_02", "spine_01", {0, 0.2f, 0}},
+                                {"neck_01", "spine_02", {0, 0.2f, 0}},
+                                {"head", "neck_01", {0, 0.1f, 0}}};
+  for (const char* side : {"l", "r"}) {
+    const float x = side[0] == 'l' ? 0.1f : -0.1f;
+    const std::string s = side;
+    j.push_back({s + "_foot", "root", {x, 0.9f, 0.2f}});  // an IK target at hip height
+    j.push_back({"thigh_" + s, "pelvis", {x, -0.05f, 0}});
+    j.push_back({"calf_" + s, "thigh_" + s, {0, -0.42f, 0.01f}});
+    j.push_back({"foot_" + s, "root", {x, 0.08f, 0}});
+    j.push_back({"ball_" + s, "root", {x, 0.02f, 0.13f}});
+  }
+  Skeleton s = placed_skeleton(j);
+  detect_joint_roles(&s);
+  EXPECT_EQ(role_joint(s, JointRole::kLeftKnee), "calf_l");
+  EXPECT_EQ(role_joint(s, JointRole::kLeftAnkle), "foot_l");
+  EXPECT_EQ(role_joint(s, JointRole::kLeftToe), "ball_l");
+  EXPECT_EQ(role_joint(s, JointRole::kRightAnkle), "foot_r");
+  EXPECT_EQ(role_joint(s, JointRole::kRightToe), "ball_r");
+  EXPECT_TRUE(s.has_locomotion_roles()) << missing_locomotion_roles(s);
+  // Without the rest pose to go by (every joint at the root), no foot is guessed.
+  for (glm::vec3& t : s.rest_translations) t = glm::vec3(0.0f, 0.1f, 0.0f);
+  detect_joint_roles(&s);
+  EXPECT_EQ(role_joint(s, JointRole::kLeftAnkle), "-");
+  EXPECT_EQ(missing_locomotion_roles(s), "left_ankle, left_toe, right_ankle, right_toe");
+}
+
+// RobotExpressive-style names (UpperLegL, a capital side letter at the end), and leg words with
+// no side at all (Blender's duplicates "Foot", "Foot.001"), sided by where they stand.
+TEST(SkeletonRoles, CapitalSideLetterAndUnsidedLegWords) {
+  std::vector<PlacedJoint> robot = {{"Hips", "", {0, 1, 0}},
+                                    {"Abdomen", "Hips", {0, 0.1f, 0}},
+                                    {"Torso", "Abdomen", {0, 0.2f, 0}},
+                                    {"Neck", "Torso", {0, 0.2f, 0}},
+                                    {"Head", "Neck", {0, 0.1f, 0}}};
+  std::vector<PlacedJoint> blender = robot;
+  for (const char* side : {"L", "R"}) {
+    const std::string s = side;
+    const float x = s == "L" ? 0.1f : -0.1f;
+    robot.push_back({"UpperLeg" + s, "Hips", {x, -0.05f, 0}});
+    robot.push_back({"LowerLeg" + s, "UpperLeg" + s, {0, -0.45f, 0}});
+    robot.push_back({"Foot" + s, "LowerLeg" + s, {0, -0.42f, 0}});
+    robot.push_back({"Ball" + s, "Foot" + s, {0, -0.05f, 0.12f}});
+    const std::string dup = s == "L" ? "" : ".001";
+    blender.push_back({"Thigh" + dup, "Hips", {x, -0.05f, 0}});
+    blender.push_back({"Shin" + dup, "Thigh" + dup, {0, -0.45f, 0}});
+    blender.push_back({"Foot" + dup, "Shin" + dup, {0, -0.42f, 0}});
+    blender.push_back({"Toe" + dup, "Foot" + dup, {0, -0.05f, 0.12f}});
+  }
+  Skeleton r = placed_skeleton(robot);
+  detect_joint_roles(&r);
+  EXPECT_EQ(role_joint(r, JointRole::kLeftHip), "UpperLegL");
+  EXPECT_EQ(role_joint(r, JointRole::kLeftKnee), "LowerLegL");
+  EXPECT_EQ(role_joint(r, JointRole::kRightAnkle), "FootR");
+  EXPECT_EQ(role_joint(r, JointRole::kRightToe), "BallR");
+  EXPECT_EQ(role_joint(r, JointRole::kChest), "Torso");
+  Skeleton b = placed_skeleton(blender);
+  detect_joint_roles(&b);
+  EXPECT_EQ(role_joint(b, JointRole::kLeftHip), "Thigh");  // at +x: the left side
+  EXPECT_EQ(role_joint(b, JointRole::kLeftToe), "Toe");
+  EXPECT_EQ(role_joint(b, JointRole::kRightKnee), "Shin.001");
+  EXPECT_EQ(role_joint(b, JointRole::kRightAnkle), "Foot.001");
+  EXPECT_TRUE(b.has_locomotion_roles()) << missing_locomotion_roles(b);
+}
+
 // Every shared BVH file and the glb resolve every role (PROVENANCE.md names the joints).
 TEST(SkeletonRoles, RealFilesResolveEveryRole) {
   const Expected cmu = {"Hips",      "LowerBack", "Spine1",       "Neck",        "Head",

@@ -18,6 +18,7 @@
 #include "render/camera.h"
 #include "tests/app/cli_support.h"
 #include "tests/app/window/demo_support.h"
+#include "tests/ik_rig_fixture.h"
 #include "tests/test_data.h"
 
 namespace gk {
@@ -329,6 +330,54 @@ TEST(DemoPanel, TheFolderBrowserLoadsAFolderOfClips) {
   EXPECT_NE(names.find("ual_walk_loop"), std::string::npos) << names;
   EXPECT_NE(names.find("ual_jog_fwd_loop"), std::string::npos) << names;
   EXPECT_EQ(names.find("walk_slow"), std::string::npos) << "the built-in set is gone: " << names;
+}
+
+// An IK-style rig with meaningless joint names (tests/ik_rig_fixture.h): loaded from the panel
+// it is refused with the way out; with a role manifest chosen under it ("roles...", the same
+// browser) it loads, and the panel shows the manifest in use.
+// Pixels of the widgets in a 1280x720 window (app/demo_panel.cc, app/file_browser.cc).
+const std::string kRolesButton = "940,257";  // "roles..." under the clip path
+const std::string kFirstEntry = "420,214";   // the browser's first listed file
+const std::string kOpenButton = "728,525";   // the browser's "open"
+
+TEST(DemoPanel, ARoleManifestIsChosenInThePanel) {
+  GK_REQUIRE_DISPLAY();
+  const std::string root = test::scratch_dir("demo_roles");
+  std::filesystem::remove_all(root + "/clips");
+  std::filesystem::create_directories(root + "/clips");
+  test::IkRigOptions o;
+  o.known_names = false;
+  const test::IkRig rig = test::make_ik_rig(o);
+  ASSERT_TRUE(test::write_file(root + "/clips/ik_rig.glb", rig.glb));
+  ASSERT_TRUE(test::write_file(root + "/clips/ik_rig_roles.json", rig.roles_json));
+  const std::string dir = test::scratch_dir("demo");
+  const std::string env = "GAITKEEPER_DATA=" + root + " ";
+  const std::string demo = "demo --size 1280x720 --scenario gallery --agents 6 ";
+  // Untick "built-in", press "browse...", then "this folder": refused, saying how.
+  const std::string load_folder =
+      "--input 2:click:1082,165 --input 5:click:940,211 --input 9:click:794,525 ";
+  const test::CommandResult refused = test::run_gaitkeeper(
+      demo + "--frames 12 " + load_folder + "--report " + dir + "/roles_refused.json", env);
+  ASSERT_EQ(refused.code, 0) << refused.out;
+  const nlohmann::json r1 = test::read_json(dir + "/roles_refused.json");
+  EXPECT_NE(r1["status"].get<std::string>().find("--roles FILE.json"), std::string::npos)
+      << r1["status"];
+  EXPECT_EQ(r1["roles"].get<std::string>(), "");
+  // Untick "built-in", press "roles...", pick the manifest and "open", then load the folder.
+  const test::CommandResult loaded = test::run_gaitkeeper(
+      demo + "--frames 24 --input 2:click:1082,165 --input 5:click:" + kRolesButton +
+          " --input 8:click:" + kFirstEntry + " --input 11:click:" + kOpenButton +
+          " --input 14:click:940,211 --input 18:click:794,525 --report " + dir +
+          "/roles_loaded.json",
+      env);
+  ASSERT_EQ(loaded.code, 0) << loaded.out;
+  const nlohmann::json r2 = test::read_json(dir + "/roles_loaded.json");
+  EXPECT_EQ(r2["status"].get<std::string>(), "");
+  EXPECT_EQ(r2["roles"].get<std::string>(), root + "/clips/ik_rig_roles.json");
+  std::string names;
+  for (const auto& c : r2["clips"]) names += c["name"].get<std::string>() + " ";
+  EXPECT_NE(names.find("walk_fast"), std::string::npos) << names;
+  EXPECT_TRUE(r2["clips_left_out"].empty()) << r2["clips_left_out"].dump();
 }
 
 }  // namespace
