@@ -69,8 +69,10 @@ class Mediator {
  public:
   Mediator(const LocomotionLibrary& library, const MediatorParams& params, size_t capacity);
 
-  // Plans every live agent of the frame for a step of dt_s [s]. Bad simulator values (NaN, absurd
-  // speeds) are sanitised per agent and counted, never propagated. A source that ignores feedback
+  // Plans every live agent of the frame for a step of dt_s [s]. The frame is validated first (dt,
+  // array lengths, capacity, ids neither reserved nor repeated): an error writes nothing, so the
+  // previous plans, feedback and slots stay as they were. Bad simulator values (NaN, absurd
+  // speeds) are not errors: they are sanitised per agent and counted, never propagated. A source that ignores feedback
   // (recorded data) is asked for none: feedback() then holds the frame's own values, unflagged.
   Status plan(const AgentFrame& frame, float dt_s,
               FeedbackPolicy policy = FeedbackPolicy::kHonoured);
@@ -88,6 +90,8 @@ class Mediator {
   std::span<const glm::vec2> sim_velocities() const { return {sim_vel_.data(), num_agents_}; }
 
  private:
+  // The checks of plan(); writes only scratch (seen_, found_slot_, new_ids_, emptied again).
+  Status validate(const AgentFrame& frame, float dt_s);
   void init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta);
   void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
                   float dt, bool feedback);
@@ -101,7 +105,8 @@ class Mediator {
   IdSlotMap ids_;
   std::vector<uint32_t> slot_id_;
   std::vector<uint8_t> seen_;
-  std::vector<int32_t> to_erase_;
+  std::vector<int32_t> found_slot_;  // scratch of validate(): agent -> known slot, or -1
+  IdSlotMap new_ids_;                // scratch of validate(): the frame's newcomers
   AnimationPlans plans_;
   FeedbackBuffers feedback_;
   std::vector<glm::vec2> sim_vel_;
