@@ -136,8 +136,10 @@ Status CrowdSession::step(double dt_s) {
   }
   times_.mediator_ms = ms_since(t);
   t = Clock::now();
-  primary_.poses->run(*primary_.mediator, dt);
-  if (compare_) compare_->poses->run(*compare_->mediator, dt);
+  for (AnimationLane* lane : {&primary_, compare_ ? &*compare_ : nullptr}) {
+    if (lane) lane->poses->run(lane->mediator->plans(), lane->mediator->num_agents(),
+                               lane->mediator->params(), dt);
+  }
   times_.pose_ms = ms_since(t);
   ++frames_run_;
   return Status::Ok();

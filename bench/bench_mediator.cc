@@ -61,7 +61,7 @@ void BM_MediatorAndPose(benchmark::State& state) {
   for (int i = 0; i < 120; ++i) {
     (void)crowd.step(kDt);
     (void)mediator.plan(crowd.frame(), kDt);
-    poses.run(mediator, kDt);
+    poses.run(mediator.plans(), mediator.num_agents(), mediator.params(), kDt);
   }
   const bool pose_only = state.range(1) == 1;
   for (auto _ : state) {
@@ -70,7 +70,7 @@ void BM_MediatorAndPose(benchmark::State& state) {
     if (pose_only) (void)mediator.plan(crowd.frame(), kDt);
     state.ResumeTiming();
     if (!pose_only) benchmark::DoNotOptimize(mediator.plan(crowd.frame(), kDt));
-    if (pose_only) poses.run(mediator, kDt);
+    if (pose_only) poses.run(mediator.plans(), mediator.num_agents(), mediator.params(), kDt);
   }
   state.counters["joints"] = lib->skeleton->num_joints();
   state.counters["sec_per_agent"] = benchmark::Counter(

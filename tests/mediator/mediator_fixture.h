@@ -78,7 +78,7 @@ inline RunResult run_scripted(const LocomotionLibrary& lib, std::vector<Script> 
     const AgentFrame frame = crowd.frame();
     const Status s = mediator.plan(frame, kDt, crowd.feedback_policy());
     EXPECT_TRUE(s.ok()) << s.message();
-    poses.run(mediator, kDt);
+    poses.run(mediator.plans(), mediator.num_agents(), mediator.params(), kDt);
     metrics.record(frame, mediator, poses);
     EXPECT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
     out.feedback_frames += crowd.last_feedback_count() > 0;

@@ -108,7 +108,7 @@ TEST(Garbage, NothingFromTheSimulatorReachesPalettesPlansOrFeedback) {
   for (int f = 0; f < 300; ++f) {
     const AgentFrame frame = crowd.frame();
     ASSERT_TRUE(mediator.plan(frame, kDt, crowd.feedback_policy()).ok()) << "frame " << f;
-    poses.run(mediator, kDt);
+    poses.run(mediator.plans(), mediator.num_agents(), mediator.params(), kDt);
     metrics.record(frame, mediator, poses);
     const AnimationPlans& pl = mediator.plans();
     for (size_t i = 0; i < frame.size(); ++i) {

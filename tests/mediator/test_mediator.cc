@@ -229,7 +229,7 @@ TEST(Mediator, AgentsComeAndGo) {
     const uint32_t base = 10 + 2 * (round % 5);
     const uint32_t ids[4] = {base, base + 1, base + 2, base + 3};
     ASSERT_TRUE(m.plan(AgentFrame{ids, p, v, th}, 1.0f / 60.0f).ok());
-    ps.run(m, 1.0f / 60.0f);
+    ps.run(m.plans(), m.num_agents(), m.params(), 1.0f / 60.0f);
     for (int i = 0; i < 4; ++i) {
       const int slot = m.plans().slot_of_agent[i];
       ASSERT_GE(slot, 0);

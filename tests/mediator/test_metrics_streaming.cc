@@ -212,7 +212,7 @@ void compare(CrowdSource& crowd, const LocomotionLibrary& lib, int frames, const
     ASSERT_TRUE(crowd.step(kDt).ok());
     const AgentFrame frame = crowd.frame();
     ASSERT_TRUE(mediator.plan(frame, kDt, crowd.feedback_policy()).ok());
-    poses.run(mediator, kDt);
+    poses.run(mediator.plans(), mediator.num_agents(), mediator.params(), kDt);
     streamed.record(frame, mediator, poses);
     exact.record(f, frame, mediator, poses, lib);
     ASSERT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());

@@ -30,7 +30,7 @@ MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, Media
     EXPECT_TRUE(crowd.step(kDt).ok());
     const AgentFrame frame = crowd.frame();
     EXPECT_TRUE(mediator.plan(frame, kDt, crowd.feedback_policy()).ok());
-    poses.run(mediator, kDt);
+    poses.run(mediator.plans(), mediator.num_agents(), mediator.params(), kDt);
     metrics.record(frame, mediator, poses);
     EXPECT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
   }
