@@ -59,11 +59,9 @@ void DemoApp::write_report(const std::string& path) const {
         {"trails", overlays_.trails},
         {"torso", overlays_.torso}}},
       {"params", nlohmann::json::parse(mediator_params_to_json(session_->params()))},
-      {"compare_params",
-       session_->has_compare()
-           ? nlohmann::json::parse(
-                 mediator_params_to_json(session_->compare_lane().mediator->params()))
-           : nlohmann::json()},
+      {"compare_params", session_->has_compare() ? nlohmann::json::parse(mediator_params_to_json(
+                                                       session_->compare_lane().params()))
+                                                 : nlohmann::json()},
       {"compare_own_crowd", session_->compare_has_own_crowd()},
       {"lessons_menu",
        {lessons_menu_rect_.x, lessons_menu_rect_.y, lessons_menu_rect_.z, lessons_menu_rect_.w}},
