@@ -64,6 +64,7 @@ struct PipelineTimes {
   double mediator_ms = 0.0;  // plan, snapshot and apply_feedback
   double pose_ms = 0.0;      // pose synthesis (and skinning palettes)
   double measure_ms = 0.0;   // metrics and frame hooks: measurement, not the animation's cost
+  double measure_cpu_ms = 0.0;  // their CPU time (they run on the calling thread alone)
 };
 
 struct PipelineOptions {
