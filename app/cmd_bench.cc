@@ -1,6 +1,7 @@
 // `gaitkeeper bench`: runs a crowd headless for a number of frames at 60 Hz and reports per-stage
 // timings (METRICS.md, "Performance") and crowd statistics, as text and optionally as JSON.
-// The frame loop is CrowdSession's; --render adds the upload and render stages, offscreen.
+// The frame loop is CrowdPipeline's (through CrowdSession), which also records the metrics and
+// the joint dump; --render adds the upload and render stages, offscreen.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -142,7 +143,7 @@ void run_bench(const BenchOptions& o) {
   // Output paths are checked before the work starts, not after minutes of simulation.
   check_output_file_option("bench", o.json, "--json");
   check_output_file_option("bench", o.dump_joints, "--dump-joints");
-  std::unique_ptr<CrowdSession> session = CrowdSession::create(o.crowd);
+  std::unique_ptr<CrowdSession> session = CrowdSession::create(o.crowd, /*record_metrics=*/true);
   CrowdSource& crowd = session->crowd();
   if (frames <= kWarmupFrames) {
     std::fprintf(stderr, "gaitkeeper bench: only %d frames; the first %d are warm-up and untimed\n",
@@ -150,14 +151,19 @@ void run_bench(const BenchOptions& o) {
   }
   const LocomotionLibrary& library = session->library();
   const MediatorParams& params = session->params();
-  const size_t capacity = std::max<size_t>(crowd.capacity(), 1);
-  MetricsRecorder metrics(library, static_cast<float>(kFrameTime_s), capacity);
+  const MetricsRecorder& metrics = *session->pipeline().metrics();
   std::optional<JointDumpWriter> dump;
   if (!o.dump_joints.empty()) {
     auto opened =
         JointDumpWriter::open(o.dump_joints, *library.skeleton, split_names(o.dump_joint_names));
     if (!opened.ok()) fail(2, opened.message());
     dump.emplace(std::move(*opened));
+    // Frame f (from 0) ends at (f + 1) frame times.
+    session->pipeline().add_frame_hook([&dump](const CrowdPipeline& p) {
+      const int64_t f = p.frames_run() - 1;
+      return dump->write_frame(static_cast<int>(f), static_cast<double>(f + 1) * kFrameTime_s,
+                               p.frame(), p.mediator(), p.poses());
+    });
   }
   // --render: the upload and render stages, offscreen, timed to completion with glFinish.
   std::optional<OffscreenScene> scene;
@@ -181,6 +187,8 @@ void run_bench(const BenchOptions& o) {
     timer.record(Stage::kSim, f, session->times().sim_ms);
     timer.record(Stage::kMediator, f, session->times().mediator_ms);
     timer.record(Stage::kPose, f, session->times().pose_ms);
+    // The metrics and the joint dump run inside the step but are measurement, not pipeline.
+    const PipelineTimes& measured_in_step = session->pipeline().times();
     if (scene) {
       session->collect();
       const Status uploaded = timer.time(Stage::kUpload, f, [&] {
@@ -197,21 +205,16 @@ void run_bench(const BenchOptions& o) {
       });
       if (!drawn.ok()) fail(1, "frame " + std::to_string(f) + ": " + drawn.message());
     }
-    const double frame_total_ms = StageTimer::ms_since(frame_start);
-    const double frame_cpu_ms = progress_every > 0 ? process_cpu_ms() - frame_cpu_start_ms : 0.0;
+    const double frame_total_ms = StageTimer::ms_since(frame_start) - measured_in_step.measure_ms;
+    const double frame_cpu_ms =
+        progress_every > 0 ? process_cpu_ms() - frame_cpu_start_ms - measured_in_step.measure_cpu_ms
+                           : 0.0;
     timer.record(Stage::kTotal, f, frame_total_ms);
 
-    // Measurement, not part of the timed pipeline.
-    const AgentFrame& frame = session->frame();
+    // Statistics of the crowd frame as planned (before feedback), not part of the timed pipeline.
+    const AgentFrame frame = session->frame();
     const Mediator& mediator = session->mediator();
     const PoseSynthesizer& poses = session->poses();
-    metrics.record(frame, mediator, poses);
-    if (dump) {
-      if (Status s = dump->write_frame(f, (f + 1) * kFrameTime_s, frame, mediator, poses);
-          !s.ok()) {
-        fail(1, s.message());
-      }
-    }
     live_sum += static_cast<double>(frame.size());
     crowd_stats.max_live_agents = std::max<int64_t>(crowd_stats.max_live_agents, frame.size());
     for (const glm::vec2& v : frame.velocities) {

@@ -151,8 +151,7 @@ void write_report(const std::string& path, const CrowdSession& s, const OrbitCam
                       {"follow_id", follow},
                       {"lesson", lesson ? lesson->name : ""}};
   if (split && s.has_compare()) {
-    j["compare_params"] =
-        nlohmann::json::parse(mediator_params_to_json(s.compare_lane().mediator->params()));
+    j["compare_params"] = nlohmann::json::parse(mediator_params_to_json(s.compare_lane().params()));
     j["compare_own_crowd"] = s.compare_has_own_crowd();
   }
   j["params"] = nlohmann::json::parse(mediator_params_to_json(s.params()));

@@ -43,7 +43,7 @@ void CrowdRecorder::record(const CrowdSession& session, int64_t selected_id) {
     }
     const AnimationLane& lane = compare ? session.compare_lane() : session.lane();
     const AgentFrame& frame = session.frame_of(lane);
-    const AnimationPlans& plans = lane.mediator->plans();
+    const AnimationPlans& plans = lane.plans();
     const size_t n = std::min(frame.size(), capacity_);
     // The selected agent is always posed: it takes the last place when it is beyond the cap.
     size_t selected_index = n;
@@ -63,7 +63,7 @@ void CrowdRecorder::record(const CrowdSession& session, int64_t selected_id) {
       a.playback_rate = s >= 0 ? plans.playback_rate[s] : 0.0f;
       a.posed = s >= 0 && (i < limit || i == selected_index) && posed < posed_cap_;
       if (!a.posed) continue;
-      const auto palette = lane.poses->palette(s);
+      const auto palette = lane.poses().palette(s);
       glm::vec4* rows = &rows_[(slot * posed_cap_ + posed) * J * 3];
       for (size_t j = 0; j < J && j < palette.size(); ++j) {
         const glm::mat4& m = palette[j];
@@ -92,7 +92,7 @@ std::optional<CrowdRecorder::AgentState> CrowdRecorder::agent(int k, int lane,
 
 size_t CrowdRecorder::restore(int k, int lane, AnimationLane* out,
                               std::vector<int64_t>* out_ids) const {
-  out->num_collected = 0;
+  out->num_collected = out->num_palettes = 0;
   if (k < 0 || k >= size() || lane < 0 || lane >= lanes_) return 0;
   const size_t slot = static_cast<size_t>(index(k)) * lanes_ + lane;
   const AgentState* states = &states_[slot * capacity_];
@@ -107,14 +107,15 @@ size_t CrowdRecorder::restore(int k, int lane, AnimationLane* out,
       for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 4; ++c) m[c][r] = rows[j * 3 + r][c];
       }
-      out->palettes[posed * J + j] = m;
+      out->recorded_palettes[posed * J + j] = m;
     }
-    out->draws[posed] = AgentDraw{glm::vec3(a.root_xz.x, 0.0f, a.root_xz.y),
-                                  agent_tint(static_cast<uint32_t>(a.id)), 0};
+    out->draws[posed] =
+        AgentDraw{glm::vec3(a.root_xz.x, 0.0f, a.root_xz.y),
+                  agent_tint(static_cast<uint32_t>(a.id)), 0, static_cast<int>(posed)};
     (*out_ids)[posed] = a.id;
     ++posed;
   }
-  out->num_collected = posed;
+  out->num_collected = out->num_palettes = posed;
   return posed;
 }
 

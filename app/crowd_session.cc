@@ -1,17 +1,11 @@
 #include "app/crowd_session.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include "animation/procedural.h"
 
 namespace gk::app {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // A replayed file carries no bounds: replay a private copy for up to a minute of its time and take
 // the box of every position seen (cheap: spline evaluation only).
@@ -38,7 +32,7 @@ glm::vec3 agent_tint(uint32_t id) {
   return glm::mix(glm::vec3(1.0f), k, 0.45f) * 0.95f;
 }
 
-std::unique_ptr<CrowdSession> CrowdSession::create(const CrowdOptions& o) {
+std::unique_ptr<CrowdSession> CrowdSession::create(const CrowdOptions& o, bool record_metrics) {
   const int threads = parse_number<int>(o.command, o.threads, "--threads", 0, 256);
   const auto seed =
       parse_number<uint64_t>(o.command, o.seed, "--seed", 0, std::numeric_limits<uint64_t>::max());
@@ -60,7 +54,7 @@ std::unique_ptr<CrowdSession> CrowdSession::create(const CrowdOptions& o) {
   s->mesh_ = lib_mesh && lib_mesh->inverse_bind.size() == static_cast<size_t>(s->num_joints_)
                  ? lib_mesh
                  : make_mannequin_mesh(skeleton);
-  s->primary_ = s->make_lane(s->params_);
+  s->primary_ = s->make_lane(s->params_, record_metrics);
   for (const WallSegment& w : s->setup_.walls) s->walls_.emplace_back(w.a.x, w.a.y, w.b.x, w.b.y);
   if (!s->setup_.walls.empty()) {
     // The walls show where the action is; a scenario's bounds often include empty margins.
@@ -82,11 +76,14 @@ std::unique_ptr<CrowdSession> CrowdSession::create(const CrowdOptions& o) {
 
 CrowdSession::~CrowdSession() = default;
 
-AnimationLane CrowdSession::make_lane(const MediatorParams& params) const {
+AnimationLane CrowdSession::make_lane(const MediatorParams& params, bool record_metrics) const {
   AnimationLane lane;
-  lane.mediator = std::make_unique<Mediator>(*library_, params, capacity_);
-  lane.poses = std::make_unique<PoseSynthesizer>(*library_, capacity_, /*make_palettes=*/true);
-  lane.palettes.assign(capacity_ * static_cast<size_t>(num_joints_), glm::mat4(1.0f));
+  PipelineOptions options;
+  options.capacity = capacity_;
+  options.make_palettes = true;
+  options.record_metrics = record_metrics;
+  options.frame_time_s = static_cast<float>(kFrameTime_s);
+  lane.pipeline = std::make_unique<CrowdPipeline>(*library_, params, options);
   lane.draws.assign(capacity_, AgentDraw{});
   return lane;
 }
@@ -99,7 +96,7 @@ void CrowdSession::enable_compare(std::function<void(MediatorParams*)> adjust, b
   compare_adjust_ = std::move(adjust);
   MediatorParams p = params_;
   if (compare_adjust_) compare_adjust_(&p);
-  compare_ = make_lane(p);
+  compare_ = make_lane(p, /*record_metrics=*/false);
   compare_crowd_.reset();
   if (own_crowd) {
     compare_crowd_.emplace(make_crowd(options_, threads_, seed_, body_radius_m_));
@@ -108,56 +105,45 @@ void CrowdSession::enable_compare(std::function<void(MediatorParams*)> adjust, b
 
 void CrowdSession::set_params(const MediatorParams& params) {
   params_ = params;
-  primary_.mediator->set_params(params);
+  primary_.pipeline->set_params(params);
   if (compare_) {
     MediatorParams p = params;
     if (compare_adjust_) compare_adjust_(&p);
-    compare_->mediator->set_params(p);
+    compare_->pipeline->set_params(p);
   }
 }
 
 Status CrowdSession::step(double dt_s) {
   const float dt = static_cast<float>(dt_s);
-  CrowdSource& crowd = *setup_.crowd;
-  auto t = Clock::now();
-  GK_RETURN_IF_ERROR(crowd.step(dt));
-  frame_ = crowd.frame();
-  times_.sim_ms = ms_since(t);
-  t = Clock::now();
-  GK_RETURN_IF_ERROR(primary_.mediator->plan(frame_, dt, crowd.feedback_policy()));
-  GK_RETURN_IF_ERROR(crowd.apply_feedback(primary_.mediator->feedback().view(frame_.size())));
-  if (compare_crowd_) {
-    CrowdSource& own = *compare_crowd_->crowd;
-    GK_RETURN_IF_ERROR(own.step(dt));
-    compare_frame_ = own.frame();
-    GK_RETURN_IF_ERROR(compare_->mediator->plan(compare_frame_, dt, own.feedback_policy()));
-    GK_RETURN_IF_ERROR(
-        own.apply_feedback(compare_->mediator->feedback().view(compare_frame_.size())));
-  } else if (compare_) {
-    GK_RETURN_IF_ERROR(compare_->mediator->plan(frame_, dt, crowd.feedback_policy()));
+  CrowdPipeline& primary = *primary_.pipeline;
+  GK_RETURN_IF_ERROR(primary.step(*setup_.crowd, dt));
+  times_ = {primary.times().sim_ms, primary.times().mediator_ms, primary.times().pose_ms};
+  if (compare_) {
+    CrowdPipeline& other = *compare_->pipeline;
+    // Its own crowd gets its own feedback; otherwise it animates the primary's frame as planned.
+    GK_RETURN_IF_ERROR(compare_crowd_
+                           ? other.step(*compare_crowd_->crowd, dt)
+                           : other.follow(primary.frame(), setup_.crowd->feedback_policy(), dt));
+    times_.sim_ms += other.times().sim_ms;
+    times_.mediator_ms += other.times().mediator_ms;
+    times_.pose_ms += other.times().pose_ms;
   }
-  times_.mediator_ms = ms_since(t);
-  t = Clock::now();
-  primary_.poses->run(*primary_.mediator, dt);
-  if (compare_) compare_->poses->run(*compare_->mediator, dt);
-  times_.pose_ms = ms_since(t);
   ++frames_run_;
   return Status::Ok();
 }
 
 void CrowdSession::collect_lane(AnimationLane* lane) const {
-  const AnimationPlans& plans = lane->mediator->plans();
-  const AgentFrame& frame = frame_of(*lane);
+  const CrowdPipeline& pipeline = *lane->pipeline;
+  const AnimationPlans& plans = pipeline.plans();
+  const AgentFrame frame = pipeline.frame();
   const size_t n = std::min(frame.size(), capacity_);
-  const size_t J = static_cast<size_t>(num_joints_);
   for (size_t i = 0; i < n; ++i) {
     const int slot = plans.slot_of_agent[i];
-    const auto palette = lane->poses->palette(slot);
-    std::copy(palette.begin(), palette.end(), lane->palettes.begin() + i * J);
     const glm::vec2 root = plans.root_xz[slot];
-    lane->draws[i] = AgentDraw{glm::vec3(root.x, 0.0f, root.y), agent_tint(frame.ids[i]), 0};
+    lane->draws[i] = AgentDraw{glm::vec3(root.x, 0.0f, root.y), agent_tint(frame.ids[i]), 0, slot};
   }
   lane->num_collected = n;
+  lane->num_palettes = pipeline.num_slots();
 }
 
 void CrowdSession::collect() {

@@ -1,12 +1,13 @@
 #pragma once
-// One running crowd with its animation: the frame loop of ARCHITECTURE.md shared by `bench`,
-// `render` and the demo. step(dt) runs sim -> Mediator::plan -> apply_feedback -> pose synthesis;
-// collect() then lays out what the renderer needs: the live agents' skinning palettes
-// (contiguous, in frame order) and their AgentDraw records.
+// One running crowd with its animation, for `bench`, `render` and the demo: the crowd source and
+// clip library built from the command line, and a CrowdPipeline (pipeline/crowd_pipeline.h, the
+// frame loop itself) per lane. collect() then lays out what the renderer needs: an AgentDraw per
+// live agent, in frame order, pointing at its palette in the pipeline's slot order (no copy).
 //
-// A second "compare" lane (another Mediator + PoseSynthesizer, e.g. naive) can be fed the very same
-// crowd frames; only the primary lane's feedback reaches the simulator, so both lanes show one
-// crowd. Everything per frame is sized at creation: step() and collect() allocate nothing.
+// A second "compare" lane (another pipeline, e.g. naive) can animate the very same crowd frames
+// (CrowdPipeline::follow: the primary's frame as it was planned, before feedback); only the
+// primary lane's feedback reaches the simulator, so both lanes show one crowd. Everything per
+// frame is sized at creation: step() and collect() allocate nothing.
 
 #include <array>
 #include <functional>
@@ -24,6 +25,7 @@
 #include "app/crowd_setup.h"
 #include "mediator/mediator.h"
 #include "mediator/pose_synthesis.h"
+#include "pipeline/crowd_pipeline.h"
 #include "render/crowd_renderer.h"
 
 namespace gk::app {
@@ -31,28 +33,38 @@ namespace gk::app {
 // Milliseconds of the last step's stages.
 struct SessionTimes {
   double sim_ms = 0.0;
-  double mediator_ms = 0.0;  // plan + apply_feedback (+ the compare lane's plan)
+  double mediator_ms = 0.0;  // plan + apply_feedback (+ the compare lane's)
   double pose_ms = 0.0;
 };
 
-// One animation pipeline over the crowd: planning, poses, and the draw data built from them.
+// One animation of the crowd and its draw data. A live lane runs a pipeline and draws its
+// palettes in slot order; a recorded lane (the demo's timeline) has no pipeline and holds the
+// palettes it restored, in draw order.
 struct AnimationLane {
-  std::unique_ptr<Mediator> mediator;
-  std::unique_ptr<PoseSynthesizer> poses;
-  std::vector<glm::mat4> palettes;  // capacity * joints, filled by collect() for live agents
-  std::vector<AgentDraw> draws;     // capacity
+  std::unique_ptr<CrowdPipeline> pipeline;   // null in a recorded lane
+  std::vector<glm::mat4> recorded_palettes;  // a recorded lane's: capacity * joints
+  std::vector<AgentDraw> draws;              // capacity; collect() fills the live agents'
   size_t num_collected = 0;
+  size_t num_palettes = 0;  // palette blocks the draws refer to (slots, or recorded agents)
   std::span<const glm::mat4> palette_span(int joints) const {
-    return {palettes.data(), num_collected * static_cast<size_t>(joints)};
+    const size_t n = num_palettes * static_cast<size_t>(joints);
+    return pipeline ? pipeline->poses().palettes().first(n)
+                    : std::span<const glm::mat4>(recorded_palettes).first(n);
   }
   std::span<const AgentDraw> draw_span() const { return {draws.data(), num_collected}; }
+  // A live lane's plans, poses and parameters.
+  const AnimationPlans& plans() const { return pipeline->plans(); }
+  const PoseSynthesizer& poses() const { return pipeline->poses(); }
+  const MediatorParams& params() const { return pipeline->params(); }
 };
 
 class CrowdSession {
  public:
-  // Builds the crowd source, the clip library, the mediator, the pose synthesizer (palettes on)
-  // from the options. Bad options end the command through fail() (ExitRequest).
-  static std::unique_ptr<CrowdSession> create(const CrowdOptions& options);
+  // Builds the crowd source, the clip library and the primary lane's pipeline (palettes on;
+  // METRICS.md recorded with `record_metrics`) from the options. Bad options end the command
+  // through fail() (ExitRequest).
+  static std::unique_ptr<CrowdSession> create(const CrowdOptions& options,
+                                              bool record_metrics = false);
   ~CrowdSession();
 
   // Adds (or replaces) the compare lane with its own mode; the other parameters are the primary's.
@@ -67,19 +79,21 @@ class CrowdSession {
   bool has_compare() const { return compare_.has_value(); }
 
   Status step(double dt_s);
-  // Fills palettes and draws of the primary lane (and the compare lane, when present).
+  // Fills the draws of the primary lane (and the compare lane, when present).
   void collect();
 
-  const AgentFrame& frame() const { return frame_; }
-  // The crowd frame a lane animates: the primary's, or the compare lane's own crowd's.
-  const AgentFrame& frame_of(const AnimationLane& lane) const {
-    return compare_crowd_ && compare_ && &lane == &*compare_ ? compare_frame_ : frame_;
-  }
+  // The crowd frame of the last step as the primary lane planned it (before feedback).
+  AgentFrame frame() const { return primary_.pipeline->frame(); }
+  // The crowd frame a live lane animates: the primary's, or the compare lane's own crowd's.
+  AgentFrame frame_of(const AnimationLane& lane) const { return lane.pipeline->frame(); }
   bool compare_has_own_crowd() const { return compare_crowd_.has_value(); }
   const AnimationLane& lane() const { return primary_; }
   const AnimationLane& compare_lane() const { return *compare_; }
-  const Mediator& mediator() const { return *primary_.mediator; }
-  const PoseSynthesizer& poses() const { return *primary_.poses; }
+  const Mediator& mediator() const { return primary_.pipeline->mediator(); }
+  const PoseSynthesizer& poses() const { return primary_.pipeline->poses(); }
+  // The primary lane's pipeline (its metrics, frame hooks).
+  CrowdPipeline& pipeline() { return *primary_.pipeline; }
+  const CrowdPipeline& pipeline() const { return *primary_.pipeline; }
   CrowdSource& crowd() { return *setup_.crowd; }
   double crowd_time_s() const { return setup_.crowd->time_s(); }
   const CrowdSetup& setup() const { return setup_; }
@@ -103,7 +117,7 @@ class CrowdSession {
 
  private:
   CrowdSession() = default;
-  AnimationLane make_lane(const MediatorParams& params) const;
+  AnimationLane make_lane(const MediatorParams& params, bool record_metrics) const;
   void collect_lane(AnimationLane* lane) const;
 
   CrowdSetup setup_;
@@ -112,7 +126,6 @@ class CrowdSession {
   uint64_t seed_ = 1;
   float body_radius_m_ = 0.0f;  // the simulator's agent radius, from the library's skeleton [m]
   std::optional<CrowdSetup> compare_crowd_;
-  AgentFrame compare_frame_;
   std::function<void(MediatorParams*)> compare_adjust_;
   std::unique_ptr<LocomotionLibrary> library_;  // stable address: the mediators refer to it
   std::shared_ptr<const SkinnedMesh> mesh_;
@@ -122,7 +135,6 @@ class CrowdSession {
   int num_joints_ = 0;
   AnimationLane primary_;
   std::optional<AnimationLane> compare_;
-  AgentFrame frame_;
   SessionTimes times_;
   int64_t frames_run_ = 0;
   std::vector<glm::vec4> walls_;

@@ -113,7 +113,7 @@ void DemoApp::record_gait() {
   const auto& clips = session_->library().clips;
   auto sample = [&](const AnimationLane& lane, GaitSample* out, bool primary) {
     const AgentFrame& frame = session_->frame_of(lane);
-    const AnimationPlans& plans = lane.mediator->plans();
+    const AnimationPlans& plans = lane.plans();
     for (size_t i = 0; i < frame.size(); ++i) {
       if (frame.ids[i] != selected_id_) continue;
       const int slot = plans.slot_of_agent[i];

@@ -61,7 +61,7 @@ void DemoApp::write_report(const std::string& path) const {
         {"legs", overlays_.legs}}},
       {"params", nlohmann::json::parse(mediator_params_to_json(session_->params()))},
       {"compare_params", session_->has_compare() ? nlohmann::json::parse(mediator_params_to_json(
-                                                       session_->compare_lane().mediator->params()))
+                                                       session_->compare_lane().params()))
                                                  : nlohmann::json()},
       {"compare_own_crowd", session_->compare_has_own_crowd()},
       {"lessons_menu",

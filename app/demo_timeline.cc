@@ -17,10 +17,11 @@ void DemoApp::reset_recorder() {
   recorder_.emplace(capacity, session_->joints(), lanes);
   scrub_ = -1;
   for (int l = 0; l < 2; ++l) {
-    replay_[l].palettes.assign(capacity * static_cast<size_t>(session_->joints()),
-                               glm::mat4(1.0f));
+    replay_[l].recorded_palettes.assign(capacity * static_cast<size_t>(session_->joints()),
+                                        glm::mat4(1.0f));
     replay_[l].draws.assign(capacity, AgentDraw{});
     replay_[l].num_collected = 0;
+    replay_[l].num_palettes = 0;
     replay_ids_[l].assign(capacity, -1);
   }
 }

@@ -21,7 +21,7 @@ void unroll(const std::array<float, LiveMetrics::kWindow>& ring, int count,
 void LiveMetrics::record(const CrowdSession& session, const AnimationLane& lane,
                          const OverlayHistory& history) {
   const AgentFrame& frame = session.frame_of(lane);
-  const AnimationPlans& plans = lane.mediator->plans();
+  const AnimationPlans& plans = lane.plans();
   double torsion = 0.0, rate = 0.0, root_error = 0.0;
   // METRICS.md v2 on this frame: walking agents with neither toe within 5 cm of its floor, and
   // the deepest foot (toe or ankle) below its floor.
@@ -31,7 +31,7 @@ void LiveMetrics::record(const CrowdSession& session, const AnimationLane& lane,
   float deepest = 0.0f;
   for (size_t i = 0; i < frame.size(); ++i) {
     const int slot = plans.slot_of_agent[i];
-    const auto w = lane.poses->world(slot);
+    const auto w = lane.poses().world(slot);
     bool near = false;
     for (int s = 0; s < 2; ++s) {
       const float toe = w[sk.toe(static_cast<Side>(s))][3].y - lib.planted_toe_m[s];
@@ -44,10 +44,10 @@ void LiveMetrics::record(const CrowdSession& session, const AnimationLane& lane,
       ++walking;
       if (!near) ++floating;
     }
-    torsion += std::abs(lane.poses->torsion(slot));
+    torsion += std::abs(lane.poses().torsion(slot));
     rate += plans.playback_rate[slot];
     // The rendered root is the skeleton's root joint (the pelvis) projected on the ground.
-    const glm::vec3 pelvis(lane.poses->world(slot)[0][3]);
+    const glm::vec3 pelvis(lane.poses().world(slot)[0][3]);
     root_error += glm::length(glm::vec2(pelvis.x, pelvis.z) - frame.positions[i]);
   }
   const double n = frame.size() ? static_cast<double>(frame.size()) : 1.0;

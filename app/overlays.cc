@@ -121,18 +121,18 @@ bool enable_overlay(const std::string& n, OverlayToggles* t) {
 std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
                                           int64_t agent_id) {
   const AgentFrame& frame = session.frame_of(lane);
-  const AnimationPlans& plans = lane.mediator->plans();
+  const AnimationPlans& plans = lane.plans();
   for (size_t i = 0; i < frame.size(); ++i) {
     if (frame.ids[i] != agent_id) continue;
     const int slot = plans.slot_of_agent[i];
     if (slot < 0) return std::nullopt;
     const glm::vec2 root = plans.root_xz[slot];
-    const float pelvis = lane.poses->pelvis_heading(slot);
+    const float pelvis = lane.poses().pelvis_heading(slot);
     TorsoReadout out;
     out.head = glm::vec3(root.x, 2.05f, root.y);
-    out.twist_deg = glm::degrees(angle_to(pelvis, lane.poses->upper_heading(slot)));
+    out.twist_deg = glm::degrees(angle_to(pelvis, lane.poses().upper_heading(slot)));
     out.theta_deg = glm::degrees(angle_to(pelvis, frame.thetas[i]));
-    out.limit_deg = lane.mediator->params().torsion_limit_deg;
+    out.limit_deg = lane.params().torsion_limit_deg;
     return out;
   }
   return std::nullopt;
@@ -141,18 +141,18 @@ std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const Ani
 std::optional<LegsReadout> legs_readout(const CrowdSession& session, const AnimationLane& lane,
                                         int64_t agent_id) {
   const AgentFrame& frame = session.frame_of(lane);
-  const AnimationPlans& plans = lane.mediator->plans();
+  const AnimationPlans& plans = lane.plans();
   for (size_t i = 0; i < frame.size(); ++i) {
     if (frame.ids[i] != agent_id) continue;
     const int slot = plans.slot_of_agent[i];
     const glm::vec2 v = frame.velocities[i];
     const float speed = glm::length(v);
-    if (slot < 0 || speed < lane.mediator->params().stop_speed_m_s) return std::nullopt;
+    if (slot < 0 || speed < lane.params().stop_speed_m_s) return std::nullopt;
     const glm::vec2 root = plans.root_xz[slot];
     LegsReadout out;
     out.head = glm::vec3(root.x, 2.05f, root.y);
     out.speed_m_s = speed;
-    const MediatorParams& params = lane.mediator->params();
+    const MediatorParams& params = lane.params();
     out.band_deg = params.turn_feedback_deg;
     const LocomotionLibrary& lib = session.library();
     if (lib.forward_group >= 0 && !lib.groups[lib.forward_group].clips.empty()) {
@@ -181,7 +181,7 @@ OverlayHistory::OverlayHistory(const CrowdSession& session, size_t capacity)
 
 void OverlayHistory::record(const CrowdSession& session, const AnimationLane& lane, float dt_s) {
   const AgentFrame& frame = session.frame_of(lane);
-  const AnimationPlans& plans = lane.mediator->plans();
+  const AnimationPlans& plans = lane.plans();
   // METRICS.md v2: the support foot (the lower toe against its floor) within 5 cm of that floor.
   constexpr float kNearFloor_m = 0.05f;
   double slide_sum = 0.0;
@@ -191,7 +191,7 @@ void OverlayHistory::record(const CrowdSession& session, const AnimationLane& la
     if (slot >= capacity_) continue;
     if (slot_id_[slot] != frame.ids[i]) slot_id_[slot] = frame.ids[i], count_[slot] = 0;
     const int k = count_[slot];
-    const auto world = lane.poses->world(static_cast<int>(slot));
+    const auto world = lane.poses().world(static_cast<int>(slot));
     float rel[2] = {1e9f, 1e9f};
     for (int s = 0; s < 2; ++s) {
       if (toe_joint_[s] >= 0) rel[s] = world[toe_joint_[s]][3].y - toe_floor_m_[s];
@@ -226,8 +226,8 @@ void OverlayHistory::record(const CrowdSession& session, const AnimationLane& la
 void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane,
                           const OverlayToggles& t, int64_t selected_id, CrowdRenderer* r) const {
   const AgentFrame& frame = session.frame_of(lane);
-  const AnimationPlans& plans = lane.mediator->plans();
-  const PoseSynthesizer& poses = *lane.poses;
+  const AnimationPlans& plans = lane.plans();
+  const PoseSynthesizer& poses = lane.poses();
   const FootLocks& locks = poses.foot_locks();
   for (size_t i = 0; i < frame.size(); ++i) {
     const size_t slot = static_cast<size_t>(plans.slot_of_agent[i]);
@@ -291,12 +291,12 @@ void OverlayHistory::draw(const CrowdSession& session, const AnimationLane& lane
       if (t.torso) {
         const int s = static_cast<int>(slot);
         torso_fan(r, ground, poses.pelvis_heading(s), poses.upper_heading(s), frame.thetas[i],
-                  glm::radians(lane.mediator->params().torsion_limit_deg));
+                  glm::radians(lane.params().torsion_limit_deg));
       }
       const glm::vec2 v = frame.velocities[i];
-      if (t.legs && glm::length(v) >= lane.mediator->params().stop_speed_m_s) {
+      if (t.legs && glm::length(v) >= lane.params().stop_speed_m_s) {
         legs_fan(r, ground, poses.pelvis_heading(static_cast<int>(slot)), std::atan2(v.x, v.y),
-                 glm::radians(lane.mediator->params().turn_feedback_deg));
+                 glm::radians(lane.params().turn_feedback_deg));
       }
       draw_selection_ring(ground, r);
     }

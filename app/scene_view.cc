@@ -106,7 +106,7 @@ Status SceneView::render(const CrowdSession& session, glm::ivec2 viewport_px, bo
     GK_RETURN_IF_ERROR(upload(session, session.lane()));
     return draw(session.lane(), glm::ivec2(0), viewport_px);
   }
-  // Palettes are re-uploaded between the halves: the renderer maps agent i to palette block i.
+  // Palettes are re-uploaded between the halves: each lane's draws index its own palettes.
   const int left = viewport_px.x / 2;
   GK_RETURN_IF_ERROR(upload(session, session.compare_lane()));
   GK_RETURN_IF_ERROR(draw(session.compare_lane(), glm::ivec2(0), {left, viewport_px.y}));

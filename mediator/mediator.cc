@@ -1,6 +1,7 @@
 #include "mediator/mediator.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -60,7 +61,8 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   const size_t L = capacity * kMaxBlendLayers;
   slot_id_.assign(capacity, 0xffffffffu);
   seen_.assign(capacity, 0);
-  to_erase_.reserve(capacity);
+  found_slot_.assign(capacity, -1);
+  new_ids_.reset(capacity);
   plans_.slot_of_agent.assign(capacity, -1);
   plans_.gait_weight.assign(capacity, 0.0f);
   plans_.agent_of_slot.assign(capacity, -1);
@@ -179,30 +181,66 @@ void Mediator::choose_weights(int slot, float speed, float rel_dir, float* w) co
   add_group_weights(lib, groups[hi], speed, u, w);
 }
 
-Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy) {
+Status Mediator::validate(const AgentFrame& frame, float dt_s) {
   if (!(dt_s > 0.0f) || !std::isfinite(dt_s) || dt_s > 1.0f) {
     return Status::Error("mediator: frame time must be in (0, 1] s, got " + std::to_string(dt_s));
   }
   const size_t n = frame.size();
+  if (frame.positions.size() != n || frame.velocities.size() != n || frame.thetas.size() != n) {
+    return Status::Error("mediator: frame arrays differ in length: " + std::to_string(n) +
+                         " ids, " + std::to_string(frame.positions.size()) + " positions, " +
+                         std::to_string(frame.velocities.size()) + " velocities, " +
+                         std::to_string(frame.thetas.size()) + " thetas");
+  }
   if (n > capacity_) {
     return Status::Error("mediator: " + std::to_string(n) + " agents exceed the capacity of " +
                          std::to_string(capacity_));
   }
-  num_agents_ = n;
+  // Ids: none reserved, none twice. Known agents are marked in seen_ (scratch) by slot; newcomers
+  // go through a scratch map that is emptied again below. Distinct ids, at most the capacity of
+  // them, always find slots once the vanished agents' are freed.
   std::fill(seen_.begin(), seen_.end(), 0);
-  std::fill(plans_.fresh.begin(), plans_.fresh.end(), 0);
-  // Known agents first, then free the slots of those that vanished, then take slots for new ones,
-  // so a crowd at capacity can swap agents within one frame.
-  for (size_t i = 0; i < n; ++i) {
-    const uint32_t id = frame.ids[i];
-    if (id == 0xffffffffu) return Status::Error("mediator: agent id 4294967295 is reserved");
+  Status status = Status::Ok();
+  size_t checked = 0;
+  for (; checked < n; ++checked) {
+    const uint32_t id = frame.ids[checked];
+    if (id == 0xffffffffu) {
+      status = Status::Error("mediator: agent id 4294967295 is reserved");
+      break;
+    }
     const int32_t slot = ids_.find(id);
-    plans_.slot_of_agent[i] = slot;
-    if (slot < 0) continue;
-    if (seen_[slot])
-      return Status::Error("mediator: agent id " + std::to_string(id) + " appears twice");
-    seen_[slot] = 1;
+    found_slot_[checked] = slot;
+    bool twice = false;
+    if (slot >= 0) {
+      twice = seen_[slot] != 0;
+      seen_[slot] = 1;
+    } else {
+      bool created = false;
+      new_ids_.insert(id, &created);
+      twice = !created;
+      if (twice) found_slot_[checked] = 0;  // not inserted by this agent: not erased below
+    }
+    if (twice) {
+      status = Status::Error("mediator: agent id " + std::to_string(id) + " appears twice");
+      ++checked;
+      break;
+    }
   }
+  for (size_t i = 0; i < checked; ++i) {
+    if (found_slot_[i] < 0) new_ids_.erase(frame.ids[i]);
+  }
+  return status;
+}
+
+Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy) {
+  // Everything is checked before anything is written: a refused frame leaves the previous plans,
+  // feedback and slots as they were (and drawable).
+  GK_RETURN_IF_ERROR(validate(frame, dt_s));
+  const size_t n = frame.size();
+  num_agents_ = n;
+  std::fill(plans_.fresh.begin(), plans_.fresh.end(), 0);
+  // Known agents keep their slots; the slots of those that vanished are freed before newcomers
+  // take theirs, so a crowd at capacity can swap agents within one frame.
   std::fill(plans_.agent_of_slot.begin(), plans_.agent_of_slot.end(), -1);
   for (size_t s = 0; s < capacity_; ++s) {
     if (!seen_[s] && slot_id_[s] != 0xffffffffu) {
@@ -211,19 +249,16 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
     }
   }
   for (size_t i = 0; i < n; ++i) {
-    if (plans_.slot_of_agent[i] >= 0) continue;
-    bool created = false;
-    const int32_t slot = ids_.insert(frame.ids[i], &created);
-    if (slot < 0 || !created) {
-      return Status::Error("mediator: agent id " + std::to_string(frame.ids[i]) +
-                           (slot < 0 ? " does not fit the capacity" : " appears twice"));
+    int32_t slot = found_slot_[i];
+    if (slot < 0) {
+      bool created = false;
+      slot = ids_.insert(frame.ids[i], &created);
+      assert(slot >= 0 && created);  // validate() made sure
+      init_slot(slot, frame.ids[i], frame.positions[i], frame.velocities[i], frame.thetas[i]);
     }
-    seen_[slot] = 1;
-    init_slot(slot, frame.ids[i], frame.positions[i], frame.velocities[i], frame.thetas[i]);
     plans_.slot_of_agent[i] = slot;
+    plans_.agent_of_slot[slot] = static_cast<int32_t>(i);
   }
-  for (size_t i = 0; i < n; ++i)
-    plans_.agent_of_slot[plans_.slot_of_agent[i]] = static_cast<int32_t>(i);
 
   const bool feedback = params_.feedback && policy == FeedbackPolicy::kHonoured;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {

@@ -14,43 +14,12 @@
 #include <glm/vec2.hpp>
 
 #include "crowd/crowd_source.h"
+#include "mediator/animation_plans.h"
 #include "mediator/id_map.h"
 #include "mediator/locomotion_library.h"
 #include "mediator/params.h"
 
 namespace gk {
-
-inline constexpr int kMaxBlendLayers = 4;
-
-// Per-slot plan for one frame, read by the pose synthesis pass and the metrics.
-struct AnimationPlans {
-  // Frame agent index -> slot, and slot -> frame agent index (-1 when the slot is free).
-  std::vector<int32_t> slot_of_agent;
-  std::vector<int32_t> agent_of_slot;
-  // Blend layers: clip index and weight (weights sum to 1; unused layers have weight 0).
-  std::vector<int16_t> layer_clip;   // [slot * kMaxBlendLayers + k]
-  std::vector<float> layer_weight;   // [slot * kMaxBlendLayers + k]
-  std::vector<float> layer_time_s;   // clip time to sample
-  std::vector<glm::vec2> root_xz;    // rendered root placement on the ground [m]
-  std::vector<float> lower_yaw;      // lower-body facing psi [rad]
-  std::vector<float> upper_yaw;      // desired upper-body facing (filtered theta) [rad]
-  std::vector<float> travel_yaw;     // travel direction implied by the played clips [rad]
-  std::vector<float> playback_rate;  // clip-time step / real time step
-  std::vector<float> speed_m_s;      // filtered speed
-  std::vector<float> plant[2];       // blended "a foot lock may start" of each foot, 0..1
-  std::vector<float> hold[2];        // blended "keep the lock" of each foot, 0..1
-  // Toe height [m] (model space, ground at 0) the gait clips alone have at this phase: a walk
-  // blended with a standing pose swings lower, and pose synthesis gives a foot that is not pinned
-  // the gait clips' own swing height back.
-  std::vector<float> gait_toe_y[2];
-  std::vector<float> gait_weight;        // share of gait clips (not standing) in the blend, 0..1
-  std::vector<float> swing_progress[2];  // blended swing progress of each foot, 0..1
-  std::vector<float> double_support;     // share of the voting clips that walk (0..1)
-  std::vector<float> phase;              // gait phase [0, 1)
-  std::vector<float> blend_progress;     // b: 0 when the chosen clips just changed, 1 when settled
-  std::vector<uint8_t> standing;         // 1 when below the stop speed
-  std::vector<uint8_t> fresh;            // 1 on the agent's first frame
-};
 
 // Feedback for the simulator, index-aligned with the last AgentFrame.
 struct FeedbackBuffers {
@@ -70,9 +39,12 @@ class Mediator {
  public:
   Mediator(const LocomotionLibrary& library, const MediatorParams& params, size_t capacity);
 
-  // Plans every live agent of the frame for a step of dt_s [s]. Bad simulator values (NaN, absurd
-  // speeds) are sanitised per agent and counted, never propagated. A source that ignores feedback
-  // (recorded data) is asked for none: feedback() then holds the frame's own values, unflagged.
+  // Plans every live agent of the frame for a step of dt_s [s]. The frame is validated first (dt,
+  // array lengths, capacity, ids neither reserved nor repeated): an error writes nothing, so the
+  // previous plans, feedback and slots stay as they were. Bad simulator values (NaN, absurd
+  // speeds) are not errors: they are sanitised per agent and counted, never propagated. A source
+  // that ignores feedback (recorded data) is asked for none: feedback() then holds the frame's own
+  // values, unflagged.
   Status plan(const AgentFrame& frame, float dt_s,
               FeedbackPolicy policy = FeedbackPolicy::kHonoured);
 
@@ -89,6 +61,8 @@ class Mediator {
   std::span<const glm::vec2> sim_velocities() const { return {sim_vel_.data(), num_agents_}; }
 
  private:
+  // The checks of plan(); writes only scratch (seen_, found_slot_, new_ids_, emptied again).
+  Status validate(const AgentFrame& frame, float dt_s);
   void init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta);
   void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
                   float dt, bool feedback);
@@ -102,7 +76,8 @@ class Mediator {
   IdSlotMap ids_;
   std::vector<uint32_t> slot_id_;
   std::vector<uint8_t> seen_;
-  std::vector<int32_t> to_erase_;
+  std::vector<int32_t> found_slot_;  // scratch of validate(): agent -> known slot, or -1
+  IdSlotMap new_ids_;                // scratch of validate(): the frame's newcomers
   AnimationPlans plans_;
   FeedbackBuffers feedback_;
   std::vector<glm::vec2> sim_vel_;

@@ -135,13 +135,13 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
 
 PoseSynthesizer::~PoseSynthesizer() = default;
 
-void PoseSynthesizer::run(const Mediator& m, float dt_s) {
-  const AnimationPlans& pl = m.plans();
-  const size_t n = m.num_agents();
+void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorParams& P, float dt_s) {
   tbb::enumerable_thread_specific<Scratch>& scratch = *scratch_;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 32), [&](const tbb::blocked_range<size_t>& r) {
     Scratch& s = scratch.local();
-    for (size_t i = r.begin(); i < r.end(); ++i) synthesize_agent(m, pl.slot_of_agent[i], dt_s, s);
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      synthesize_agent(pl, P, pl.slot_of_agent[i], dt_s, s);
+    }
   });
 }
 
@@ -155,9 +155,8 @@ void PoseSynthesizer::fk_from(int slot, int first, const glm::mat4& root) {
   }
 }
 
-void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Scratch& s) {
-  const AnimationPlans& pl = m.plans();
-  const MediatorParams& P = m.params();
+void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot,
+                                       float dt, Scratch& s) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   if (pl.fresh[slot]) {
@@ -203,7 +202,7 @@ void PoseSynthesizer::synthesize_agent(const Mediator& m, int slot, float dt, Sc
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   fk_from(slot, 0, root);
   if (apm) twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
-  if (apm && P.foot_locking) lock_feet(m, slot, root, dt);
+  if (apm && P.foot_locking) lock_feet(pl, P, slot, root, dt);
 
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
@@ -264,9 +263,8 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   fk_from(slot, first_spine_joint_, root);
 }
 
-void PoseSynthesizer::lock_feet(const Mediator& m, int slot, const glm::mat4& root, float dt) {
-  const AnimationPlans& pl = m.plans();
-  const MediatorParams& P = m.params();
+void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
+                                const glm::mat4& root, float dt) {
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
                           library_.swing_height_m};

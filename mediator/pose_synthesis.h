@@ -13,9 +13,10 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 
+#include "mediator/animation_plans.h"
 #include "mediator/foot_lock.h"
 #include "mediator/locomotion_library.h"
-#include "mediator/mediator.h"
+#include "mediator/params.h"
 
 namespace gk {
 
@@ -33,8 +34,10 @@ class PoseSynthesizer {
   PoseSynthesizer(const LocomotionLibrary& library, size_t capacity, bool make_palettes);
   ~PoseSynthesizer();
 
-  // Synthesises every live agent of the mediator's last plan.
-  void run(const Mediator& mediator, float dt_s);
+  // Synthesises the first num_agents agents of `plans` (the mediator's last plan: agent i in slot
+  // plans.slot_of_agent[i]) with the parameters they were planned with.
+  void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
+           float dt_s);
 
   int num_joints() const { return num_joints_; }
   // World transforms of one slot's joints, as rendered.
@@ -42,6 +45,8 @@ class PoseSynthesizer {
     return {world_.data() + static_cast<size_t>(slot) * num_joints_,
             static_cast<size_t>(num_joints_)};
   }
+  // Every slot's skinning palette, slot after slot (empty without make_palettes).
+  std::span<const glm::mat4> palettes() const { return palette_; }
   std::span<const glm::mat4> palette(int slot) const {
     return {palette_.data() + static_cast<size_t>(slot) * num_joints_,
             static_cast<size_t>(num_joints_)};
@@ -63,10 +68,12 @@ class PoseSynthesizer {
 
  private:
   struct Scratch;
-  void synthesize_agent(const Mediator& m, int slot, float dt, Scratch& s);
+  void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
+                        Scratch& s);
   void fk_from(int slot, int first_joint, const glm::mat4& root);
   void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
-  void lock_feet(const Mediator& m, int slot, const glm::mat4& root, float dt);
+  void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
+                 float dt);
 
   const LocomotionLibrary& library_;
   const Skeleton& skeleton_;

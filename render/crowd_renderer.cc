@@ -9,6 +9,11 @@
 namespace gk {
 namespace {
 
+// The palette block an agent is skinned with: its own, or its index in draw() by default.
+int64_t palette_block(const AgentDraw& a, size_t i) {
+  return a.palette < 0 ? static_cast<int64_t>(i) : a.palette;
+}
+
 template <typename T>
 void grow_to(std::vector<T>* v, size_t n) {
   if (v->size() < n) v->resize(std::max(n, v->size() + v->size() / 2));
@@ -190,8 +195,9 @@ int CrowdRenderer::cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport
     const int i = visible_[v];
     const AgentDraw& a = agents[i];
     const float shadow = meshes_[a.mesh].shadow_radius_m * settings_.shadow_radius_scale;
-    instances_[mesh_first_[a.mesh]++] = {a.tint, static_cast<uint32_t>(i * joints_per_agent_),
-                                         glm::vec4(a.position, shadow)};
+    const auto base =
+        static_cast<uint32_t>(palette_block(a, static_cast<size_t>(i)) * joints_per_agent_);
+    instances_[mesh_first_[a.mesh]++] = {a.tint, base, glm::vec4(a.position, shadow)};
   }
   for (size_t k = 0; k < meshes_.size(); ++k) mesh_first_[k] -= mesh_count_[k];
   return num_visible;
@@ -209,11 +215,13 @@ Status CrowdRenderer::draw_region(const OrbitCamera& camera, glm::ivec2 origin_p
     return Status::Error("draw: bad viewport " + std::to_string(viewport_px.x) + "x" +
                          std::to_string(viewport_px.y));
   }
-  if (!agents.empty() && static_cast<int64_t>(agents.size()) > num_palette_agents_) {
-    return Status::Error("draw: " + std::to_string(agents.size()) + " agents but palettes for " +
-                         std::to_string(num_palette_agents_) + " were uploaded");
-  }
   for (size_t i = 0; i < agents.size(); ++i) {
+    const int64_t palette = palette_block(agents[i], i);
+    if (palette < 0 || palette >= num_palette_agents_) {
+      return Status::Error("draw: agent " + std::to_string(i) + " uses palette block " +
+                           std::to_string(palette) + " but palettes for " +
+                           std::to_string(num_palette_agents_) + " were uploaded");
+    }
     const int mesh = agents[i].mesh;
     if (mesh < 0 || mesh >= num_meshes()) {
       return Status::Error("draw: agent " + std::to_string(i) + " has mesh id " +

@@ -26,11 +26,15 @@
 
 namespace gk {
 
-// One agent to draw this frame. Agent i of draw() uses palette block i of upload_palettes().
+// One agent to draw this frame, skinned with palette block `palette` of upload_palettes(): the
+// palettes may stay in whatever order their producer keeps them (a mediator's slots), no copy.
 struct AgentDraw {
   glm::vec3 position{0.0f};  // ground point under the agent [m]: culling sphere and contact shadow
   glm::vec3 tint{1.0f};      // linear RGB multiplier of the mesh colours (per-agent variation)
   int mesh = 0;              // id returned by add_mesh
+  // Palette block of this agent [Limit: < blocks uploaded]; negative (the default): block i for
+  // agent i of draw(), for palettes uploaded in draw order.
+  int palette = -1;
 };
 
 // An upright box standing on or above the ground (exhibits, props): lit like the walls.
@@ -105,8 +109,9 @@ class CrowdRenderer {
   Result<int> add_mesh(const SkinnedMesh& mesh);
   int num_meshes() const { return static_cast<int>(meshes_.size()); }
 
-  // All agents' skinning palettes, agent after agent, joints_per_agent matrices each (world-space
-  // palettes: model[j] * inverse_bind[j] with the agent's placement in model). One GPU upload.
+  // All agents' skinning palettes, block after block, joints_per_agent matrices each (world-space
+  // palettes: model[j] * inverse_bind[j] with the agent's placement in model); AgentDraw::palette
+  // picks an agent's block. One GPU upload.
   Status upload_palettes(std::span<const glm::mat4> palettes, int joints_per_agent);
 
   // Walls as 2D segments on the ground, (x0, z0, x1, z1) [m] each, drawn as low boxes with the

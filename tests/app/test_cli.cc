@@ -179,7 +179,10 @@ TEST(Cli, FeedbackSlowsRunnersToWhatWalkingLegsCanDo) {
     slide[on] = rep["metrics"]["support_slide_cm_s"].get<double>();
   }
   // walk_fast is generated at 1.8 m/s (animation/procedural_clips.cc): the legs' maximum here.
-  EXPECT_LE(max_speed[1], 1.8 * 1.02);
+  // The crowd's speeds are those the simulator proposes, before feedback: one frame of its
+  // driving force above what was fed back (dv/dt = (v0 - v) / tau with the fastest runner's
+  // v0 = 3.8 m/s and tau = 0.5 s, crowd/social_forces.h), plus the other agents' pushes.
+  EXPECT_LE(max_speed[1], 1.8 + (3.8 - 1.8) / 0.5 / 60.0 + 0.02);
   EXPECT_GT(speed[0], 1.8 * 1.2) << "without feedback the runners keep running";
   EXPECT_LT(slide[1], 0.25 * slide[0]) << "feet slide without feedback, stand with it";
 }

@@ -1,5 +1,6 @@
 #pragma once
-// Runs the mediator and pose synthesis over a scripted crowd and returns the METRICS.md report.
+// Runs a scripted crowd through CrowdPipeline (mediator, feedback, pose synthesis) and returns the
+// METRICS.md report.
 
 #include <initializer_list>
 #include <memory>
@@ -10,6 +11,7 @@
 #include "mediator/mediator.h"
 #include "mediator/metrics.h"
 #include "mediator/pose_synthesis.h"
+#include "pipeline/crowd_pipeline.h"
 #include "tests/mediator/scripted_crowd.h"
 #include "tests/test_data.h"
 
@@ -59,6 +61,16 @@ inline Result<LocomotionLibrary> load_data_library(std::initializer_list<const c
   return build_locomotion_library(*sets);
 }
 
+// A headless pipeline that records the metrics (no palettes: nothing is drawn).
+inline PipelineOptions test_pipeline_options(size_t capacity, float frame_time_s) {
+  PipelineOptions o;
+  o.capacity = capacity;
+  o.make_palettes = false;
+  o.record_metrics = true;
+  o.frame_time_s = frame_time_s;
+  return o;
+}
+
 struct RunResult {
   MetricsReport report;
   uint64_t sanitised = 0;
@@ -69,22 +81,15 @@ inline RunResult run_scripted(const LocomotionLibrary& lib, std::vector<Script> 
                               MediatorParams params, int frames = 600, bool honour = false) {
   constexpr float kDt = 1.0f / 60.0f;
   ScriptedCrowd crowd(std::move(scripts), honour);
-  Mediator mediator(lib, params, crowd.capacity());
-  PoseSynthesizer poses(lib, crowd.capacity(), false);
-  MetricsRecorder metrics(lib, kDt, crowd.capacity());
+  CrowdPipeline pipeline(lib, params, test_pipeline_options(crowd.capacity(), kDt));
   RunResult out;
   for (int f = 0; f < frames; ++f) {
-    EXPECT_TRUE(crowd.step(kDt).ok());
-    const AgentFrame frame = crowd.frame();
-    const Status s = mediator.plan(frame, kDt, crowd.feedback_policy());
+    const Status s = pipeline.step(crowd, kDt);
     EXPECT_TRUE(s.ok()) << s.message();
-    poses.run(mediator, kDt);
-    metrics.record(frame, mediator, poses);
-    EXPECT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
     out.feedback_frames += crowd.last_feedback_count() > 0;
   }
-  out.report = metrics.finish();
-  out.sanitised = mediator.num_sanitised();
+  out.report = pipeline.metrics()->finish();
+  out.sanitised = pipeline.mediator().num_sanitised();
   return out;
 }
 

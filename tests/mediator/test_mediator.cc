@@ -229,7 +229,7 @@ TEST(Mediator, AgentsComeAndGo) {
     const uint32_t base = 10 + 2 * (round % 5);
     const uint32_t ids[4] = {base, base + 1, base + 2, base + 3};
     ASSERT_TRUE(m.plan(AgentFrame{ids, p, v, th}, 1.0f / 60.0f).ok());
-    ps.run(m, 1.0f / 60.0f);
+    ps.run(m.plans(), m.num_agents(), m.params(), 1.0f / 60.0f);
     for (int i = 0; i < 4; ++i) {
       const int slot = m.plans().slot_of_agent[i];
       ASSERT_GE(slot, 0);
@@ -238,6 +238,68 @@ TEST(Mediator, AgentsComeAndGo) {
       EXPECT_NEAR(root.x, p[i].x, 0.1f);
     }
   }
+}
+
+// Issue #11: plan() checks the whole frame before it writes anything. Before, a repeated newcomer
+// id was found after num_agents_, slot_of_agent and the id map (vanished agents erased) had been
+// written: the app then drew half-written plans, and the next good frame restarted agents.
+TEST(Mediator, RefusedFrameChangesNothing) {
+  const LocomotionLibrary& lib = builtin_library();
+  Mediator m(lib, MediatorParams{}, 6);
+  const glm::vec2 p[5] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {4, 0}};
+  const glm::vec2 v[5] = {{0, 1}, {0, 1.2f}, {0, 1.4f}, {0, 1}, {0, 1}};
+  const float th[5] = {};
+  const uint32_t good[3] = {1, 2, 3};
+  for (int f = 0; f < 30; ++f) {
+    ASSERT_TRUE(m.plan(AgentFrame{{good, 3}, {p, 3}, {v, 3}, {th, 3}}, 1.0f / 60.0f).ok());
+  }
+  const AnimationPlans before = m.plans();
+  const FeedbackBuffers feedback_before = m.feedback();
+  auto expect_unchanged = [&](const char* what) {
+    SCOPED_TRACE(what);
+    EXPECT_EQ(m.num_agents(), 3u);
+    const AnimationPlans& now = m.plans();
+    EXPECT_EQ(now.slot_of_agent, before.slot_of_agent);
+    EXPECT_EQ(now.agent_of_slot, before.agent_of_slot);
+    EXPECT_EQ(now.layer_clip, before.layer_clip);
+    EXPECT_EQ(now.layer_weight, before.layer_weight);
+    EXPECT_EQ(now.layer_time_s, before.layer_time_s);
+    EXPECT_EQ(now.root_xz, before.root_xz);
+    EXPECT_EQ(now.lower_yaw, before.lower_yaw);
+    EXPECT_EQ(now.phase, before.phase);
+    EXPECT_EQ(now.fresh, before.fresh);
+    EXPECT_EQ(m.feedback().velocities, feedback_before.velocities);
+    EXPECT_EQ(m.feedback().has_feedback, feedback_before.has_feedback);
+  };
+  // Agent 3 vanishes, and newcomer 9 comes twice.
+  const uint32_t twice_new[4] = {1, 2, 9, 9};
+  Status s = m.plan(AgentFrame{{twice_new, 4}, {p, 4}, {v, 4}, {th, 4}}, 1.0f / 60.0f);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("agent id 9 appears twice"), std::string::npos) << s.message();
+  expect_unchanged("newcomer twice");
+  const uint32_t twice_known[4] = {1, 2, 3, 2};
+  s = m.plan(AgentFrame{{twice_known, 4}, {p, 4}, {v, 4}, {th, 4}}, 1.0f / 60.0f);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("agent id 2 appears twice"), std::string::npos) << s.message();
+  expect_unchanged("known agent twice");
+  const uint32_t reserved[4] = {1, 5, 0xffffffffu, 2};
+  EXPECT_FALSE(m.plan(AgentFrame{{reserved, 4}, {p, 4}, {v, 4}, {th, 4}}, 1.0f / 60.0f).ok());
+  expect_unchanged("reserved id");
+  s = m.plan(AgentFrame{{good, 3}, {p, 2}, {v, 3}, {th, 3}}, 1.0f / 60.0f);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("differ in length"), std::string::npos) << s.message();
+  expect_unchanged("short positions");
+  EXPECT_FALSE(m.plan(AgentFrame{{good, 3}, {p, 3}, {v, 3}, {th, 3}}, NAN).ok());
+  expect_unchanged("NaN frame time");
+
+  // The scratch of the refused frames left nothing behind: the same agents carry on in their
+  // slots (none restarted), and the newcomer 9 of the refused frame is new when it really comes.
+  ASSERT_TRUE(m.plan(AgentFrame{{good, 3}, {p, 3}, {v, 3}, {th, 3}}, 1.0f / 60.0f).ok());
+  EXPECT_EQ(m.plans().slot_of_agent, before.slot_of_agent);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(m.plans().fresh[m.plans().slot_of_agent[i]], 0) << i;
+  const uint32_t with_9[4] = {1, 2, 3, 9};
+  ASSERT_TRUE(m.plan(AgentFrame{{with_9, 4}, {p, 4}, {v, 4}, {th, 4}}, 1.0f / 60.0f).ok());
+  EXPECT_EQ(m.plans().fresh[m.plans().slot_of_agent[3]], 1);
 }
 
 // Issue #12: a parameter file must fail with a message, whatever is wrong with it.

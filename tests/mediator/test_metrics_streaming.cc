@@ -203,22 +203,20 @@ V1 exact_v1(const std::vector<StoredTrack>& tracks, int lag, float extra_toe = 0
 
 void compare(CrowdSource& crowd, const LocomotionLibrary& lib, int frames, const char* what) {
   SCOPED_TRACE(what);
-  Mediator mediator(lib, MediatorParams{}, crowd.capacity());
-  PoseSynthesizer poses(lib, crowd.capacity(), false);
-  MetricsRecorder streamed(lib, kDt, crowd.capacity());
+  CrowdPipeline pipeline(lib, MediatorParams{}, test::test_pipeline_options(crowd.capacity(), kDt));
+  const MetricsRecorder& streamed = *pipeline.metrics();
   ExactRun exact;
+  // The exact figures from the very frames the pipeline recorded (as planned, before feedback).
+  pipeline.add_frame_hook([&](const CrowdPipeline& p) {
+    exact.record(static_cast<int>(p.frames_run() - 1), p.frame(), p.mediator(), p.poses(), lib);
+    return Status::Ok();
+  });
   size_t most_live = 0;
   for (int f = 0; f < frames; ++f) {
-    ASSERT_TRUE(crowd.step(kDt).ok());
-    const AgentFrame frame = crowd.frame();
-    ASSERT_TRUE(mediator.plan(frame, kDt, crowd.feedback_policy()).ok());
-    poses.run(mediator, kDt);
-    streamed.record(frame, mediator, poses);
-    exact.record(f, frame, mediator, poses, lib);
-    ASSERT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
+    ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
     // Bounded by the live agents: a track ends the frame its agent is gone.
-    ASSERT_EQ(streamed.num_live_tracks(), frame.size()) << "frame " << f;
-    most_live = std::max(most_live, frame.size());
+    ASSERT_EQ(streamed.num_live_tracks(), pipeline.frame().size()) << "frame " << f;
+    most_live = std::max(most_live, pipeline.frame().size());
   }
   const MetricsReport r = streamed.finish();
   EXPECT_GT(exact.tracks.size(), most_live / 2);

@@ -23,18 +23,12 @@ constexpr int kFrames = 600;
 MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, MediatorMode mode) {
   MediatorParams params;
   params.mode = mode;
-  Mediator mediator(lib, params, crowd.capacity());
-  PoseSynthesizer poses(lib, crowd.capacity(), false);
-  MetricsRecorder metrics(lib, kDt, crowd.capacity());
+  CrowdPipeline pipeline(lib, params, test::test_pipeline_options(crowd.capacity(), kDt));
   for (int f = 0; f < kFrames; ++f) {
-    EXPECT_TRUE(crowd.step(kDt).ok());
-    const AgentFrame frame = crowd.frame();
-    EXPECT_TRUE(mediator.plan(frame, kDt, crowd.feedback_policy()).ok());
-    poses.run(mediator, kDt);
-    metrics.record(frame, mediator, poses);
-    EXPECT_TRUE(crowd.apply_feedback(mediator.feedback().view(frame.size())).ok());
+    const Status s = pipeline.step(crowd, kDt);
+    EXPECT_TRUE(s.ok()) << s.message();
   }
-  return metrics.finish();
+  return pipeline.metrics()->finish();
 }
 
 std::unique_ptr<CrowdSource> scenario_crowd(const std::string& name, bool detour = false) {

@@ -1,0 +1,45 @@
+#pragma once
+// The mediator's output for one frame, per slot (structure of arrays sized for the crowd's
+// capacity): what pose synthesis and the metrics read. Its own header so that pose synthesis
+// depends on the plans, not on the Mediator that makes them.
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+namespace gk {
+
+inline constexpr int kMaxBlendLayers = 4;
+
+// Per-slot plan for one frame, read by the pose synthesis pass and the metrics.
+struct AnimationPlans {
+  // Frame agent index -> slot, and slot -> frame agent index (-1 when the slot is free).
+  std::vector<int32_t> slot_of_agent;
+  std::vector<int32_t> agent_of_slot;
+  // Blend layers: clip index and weight (weights sum to 1; unused layers have weight 0).
+  std::vector<int16_t> layer_clip;   // [slot * kMaxBlendLayers + k]
+  std::vector<float> layer_weight;   // [slot * kMaxBlendLayers + k]
+  std::vector<float> layer_time_s;   // clip time to sample
+  std::vector<glm::vec2> root_xz;    // rendered root placement on the ground [m]
+  std::vector<float> lower_yaw;      // lower-body facing psi [rad]
+  std::vector<float> upper_yaw;      // desired upper-body facing (filtered theta) [rad]
+  std::vector<float> travel_yaw;     // travel direction implied by the played clips [rad]
+  std::vector<float> playback_rate;  // clip-time step / real time step
+  std::vector<float> speed_m_s;      // filtered speed
+  std::vector<float> plant[2];       // blended "a foot lock may start" of each foot, 0..1
+  std::vector<float> hold[2];        // blended "keep the lock" of each foot, 0..1
+  // Toe height [m] (model space, ground at 0) the gait clips alone have at this phase: a walk
+  // blended with a standing pose swings lower, and pose synthesis gives a foot that is not pinned
+  // the gait clips' own swing height back.
+  std::vector<float> gait_toe_y[2];
+  std::vector<float> gait_weight;        // share of gait clips (not standing) in the blend, 0..1
+  std::vector<float> swing_progress[2];  // blended swing progress of each foot, 0..1
+  std::vector<float> double_support;     // share of the voting clips that walk (0..1)
+  std::vector<float> phase;              // gait phase [0, 1)
+  std::vector<float> blend_progress;     // b: 0 when the chosen clips just changed, 1 when settled
+  std::vector<uint8_t> standing;         // 1 when below the stop speed
+  std::vector<uint8_t> fresh;            // 1 on the agent's first frame
+};
+
+}  // namespace gk
