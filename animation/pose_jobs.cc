@@ -184,8 +184,11 @@ void TwoBoneIKJob::run() const {
   const float reach = glm::length(target - a);
   const float max_len = (lab + lcb) * max_extension;
   const float min_len = std::abs(lab - lcb) + 1e-4f;
+  // Only reach beyond the pose's own is softened: a leg the animation itself stretches that far is
+  // reached exactly (it straightens no faster than the animation does).
   float soft_reach = reach;
-  const float soft_start = max_len * std::clamp(soften, 0.0f, 1.0f);
+  const float soft_start = std::max(max_len * std::clamp(soften, 0.0f, 1.0f),
+                                    std::min(glm::length(c - a), max_len));
   const float soft_span = max_len - soft_start;
   if (soft_span > 1e-6f && reach > soft_start) {
     soft_reach = soft_start + soft_span * (1.0f - std::exp(-(reach - soft_start) / soft_span));

@@ -75,7 +75,8 @@ struct TwoBoneIKJob {
   float max_extension = 0.999f;
   // Soft IK: beyond this fraction of max_extension the chain reaches ever less of the remaining
   // distance (an exponential approach, continuous in value and slope), so a knee straightens
-  // smoothly instead of snapping as the target crosses full reach (1 = off, a hard clamp).
+  // smoothly instead of snapping as the target crosses full reach (1 = off, a hard clamp). Reach
+  // up to the pose's own hip-to-end distance is never softened.
   float soften = 1.0f;
   glm::quat* out_start_correction = nullptr;
   glm::quat* out_mid_correction = nullptr;
