@@ -221,6 +221,7 @@ Status DemoApp::render_scene(float real_dt_s) {
   OrbitCamera overview = frame_bounds(session_->bounds_min(), session_->bounds_max(), view_size());
   if (overview_yaw_) overview.yaw_rad = *overview_yaw_;
   director_.set_overview(overview);
+  director_.set_view(view_size());
   director_.update(session_->crowd().time_s(), real_dt_s,
                    shown_followed(), &camera_);
   view_->camera() = camera_;
