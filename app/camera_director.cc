@@ -51,10 +51,12 @@ void spring_step(glm::vec3* x, glm::vec3* v, const glm::vec3& goal, const glm::v
 }
 
 float distance_to_show(const OrbitCamera& camera, std::span<const glm::vec3> points,
-                       glm::ivec2 view_px, float margin, float min_distance_m) {
+                       glm::ivec2 view_px, float margin, float min_distance_m,
+                       int bottom_inset_px) {
   OrbitCamera c = camera;
   const glm::vec2 lo(margin * static_cast<float>(view_px.y));
-  const glm::vec2 hi = glm::vec2(view_px) - lo;
+  const glm::vec2 hi =
+      glm::vec2(view_px) - lo - glm::vec2(0.0f, static_cast<float>(std::max(bottom_inset_px, 0)));
   for (c.distance_m = std::max(min_distance_m, 0.5f); c.distance_m < 80.0f;
        c.distance_m *= 1.01f) {
     bool all = true;
@@ -131,7 +133,8 @@ void CameraDirector::update(double sim_time_s, float dt_s,
     for (const glm::vec3& p : {followed->position, *followed->twin}) {
       points.insert(points.end(), {p + up, p + ex, p - ex, p + ez, p - ez});
     }
-    goal_distance_m = distance_to_show(aim, points, view_px_, 0.08f, follow_distance_m_);
+    goal_distance_m =
+        distance_to_show(aim, points, view_px_, 0.08f, follow_distance_m_, bottom_inset_px_);
   }
   if (closing_in_ && !close_in_started_) {
     close_in_started_ = true;

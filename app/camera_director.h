@@ -53,8 +53,11 @@ class CameraDirector {
   void user_took_camera() {
     pull_out_at_s_.reset(), pulling_out_ = false, closing_in_ = false, user_zoomed_ = true;
   }
-  // The size [px] of the view (one half of a split) the camera draws: what a twin is fitted into.
-  void set_view(glm::ivec2 view_px) { view_px_ = view_px; }
+  // The size [px] of the view (one half of a split) the camera draws: what a twin is fitted into,
+  // above `bottom_inset_px` (text drawn over the bottom of the view).
+  void set_view(glm::ivec2 view_px, int bottom_inset_px = 0) {
+    view_px_ = view_px, bottom_inset_px_ = bottom_inset_px;
+  }
   // The next update jumps to its goal instead of moving there (the first frame of a shot).
   void snap() { snap_ = true; }
 
@@ -78,6 +81,7 @@ class CameraDirector {
   bool snap_ = false;
   bool user_zoomed_ = false;  // the user took the camera: a twin no longer moves the distance
   glm::ivec2 view_px_{16, 9};
+  int bottom_inset_px_ = 0;
   glm::vec3 target_velocity_{0.0f};
   float distance_velocity_ = 0.0f;
   float pitch_velocity_ = 0.0f;
@@ -86,9 +90,10 @@ class CameraDirector {
 
 // The distance [m], at least `min_distance_m`, from which `camera` (its target, yaw and pitch kept)
 // shows every point of `points` inside a view of `view_px` with `margin` (a fraction of the view's
-// height) to spare; at most 80 m.
+// height) to spare, and above the bottom `bottom_inset_px`; at most 80 m.
 float distance_to_show(const OrbitCamera& camera, std::span<const glm::vec3> points,
-                       glm::ivec2 view_px, float margin, float min_distance_m);
+                       glm::ivec2 view_px, float margin, float min_distance_m,
+                       int bottom_inset_px = 0);
 
 // One step of a critically damped spring toward a goal that moves at `goal_velocity`, exact for a
 // goal moving at constant velocity: x'' = w^2 (goal - x) + 2 w (goal_velocity - v), w from the
