@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -24,6 +25,11 @@ inline constexpr float kFollowHeight_m = 0.9f;    // the camera aims at the hips
 struct FollowedAgent {
   glm::vec3 position{0.0f};
   glm::vec2 velocity_xz{0.0f};
+  // A split whose halves run their own crowds (the feedback lesson) shows the same agent in two
+  // places under one camera: its ground position [m] in the other half. The camera then aims
+  // between the two and, until the user zooms, backs away until both bodies and the labels over
+  // their heads are in view.
+  std::optional<glm::vec3> twin;
 };
 
 class CameraDirector {
@@ -44,7 +50,14 @@ class CameraDirector {
   bool pull_out_pending() const { return pull_out_at_s_.has_value(); }
   // The user took the camera (orbit, zoom): scripted moves (closing in, the pull-out) stop;
   // following continues.
-  void user_took_camera() { pull_out_at_s_.reset(), pulling_out_ = false, closing_in_ = false; }
+  void user_took_camera() {
+    pull_out_at_s_.reset(), pulling_out_ = false, closing_in_ = false, user_zoomed_ = true;
+  }
+  // The size [px] of the view (one half of a split) the camera draws: what a twin is fitted into,
+  // above `bottom_inset_px` (text drawn over the bottom of the view).
+  void set_view(glm::ivec2 view_px, int bottom_inset_px = 0) {
+    view_px_ = view_px, bottom_inset_px_ = bottom_inset_px;
+  }
   // The next update jumps to its goal instead of moving there (the first frame of a shot).
   void snap() { snap_ = true; }
 
@@ -66,11 +79,21 @@ class CameraDirector {
   std::optional<double> pull_out_at_s_;
   bool pulling_out_ = false;
   bool snap_ = false;
+  bool user_zoomed_ = false;  // the user took the camera: a twin no longer moves the distance
+  glm::ivec2 view_px_{16, 9};
+  int bottom_inset_px_ = 0;
   glm::vec3 target_velocity_{0.0f};
   float distance_velocity_ = 0.0f;
   float pitch_velocity_ = 0.0f;
   float yaw_velocity_ = 0.0f;
 };
+
+// The distance [m], at least `min_distance_m`, from which `camera` (its target, yaw and pitch kept)
+// shows every point of `points` inside a view of `view_px` with `margin` (a fraction of the view's
+// height) to spare, and above the bottom `bottom_inset_px`; at most 80 m.
+float distance_to_show(const OrbitCamera& camera, std::span<const glm::vec3> points,
+                       glm::ivec2 view_px, float margin, float min_distance_m,
+                       int bottom_inset_px = 0);
 
 // One step of a critically damped spring toward a goal that moves at `goal_velocity`, exact for a
 // goal moving at constant velocity: x'' = w^2 (goal - x) + 2 w (goal_velocity - v), w from the

@@ -82,14 +82,21 @@ OverlayToggles parse_overlays(const std::vector<std::string>& names) {
   return t;
 }
 
-// A label centred above `head` [m] in the half (or whole) image at `origin_x` of width `view.x`.
+// A label centred above `head` [m] in the half (or whole) image at `origin_x` of width `view.x`,
+// kept inside that half when the head is near or beyond its edge.
 void stamp_above(const char* text, glm::vec3 head, const OrbitCamera& camera, glm::ivec2 view,
                  int origin_x, int scale, FrameCapture* capture, glm::ivec2 image) {
   const ProjectedPoint p = camera.project(head, view);
   if (!p.in_front) return;
   const int w = label_width(text, scale);
-  const glm::ivec2 at(origin_x + static_cast<int>(p.pixel.x) - w / 2,
-                      static_cast<int>(p.pixel.y) - 9 * scale);
+  const int margin = 2 * scale;
+  const int x = std::clamp(static_cast<int>(p.pixel.x) - w / 2, margin,
+                           std::max(margin, view.x - w - margin));
+  // Below the half's name in the top left corner, above the caption along the bottom.
+  const int top = 18 * scale;
+  const int y = std::clamp(static_cast<int>(p.pixel.y) - 9 * scale, top,
+                           std::max(top, view.y - 20 * scale));
+  const glm::ivec2 at(origin_x + x, y);
   stamp_label(capture->mutable_rgba(), image, at, text, scale);
 }
 
@@ -163,6 +170,18 @@ void write_report(const std::string& path, const CrowdSession& s, const OrbitCam
                      {"limit_deg", t->limit_deg},
                      {"head_px", head.pixel.x},
                      {"head_py", head.pixel.y}};
+  }
+  // The followed agent's places in both halves of a split whose halves run their own crowds.
+  if (const std::optional<FollowedAgent> f = followed_agent(s, follow); f && f->twin) {
+    nlohmann::json places = nlohmann::json::array();
+    for (const glm::vec3& p : {f->position, *f->twin}) {
+      const ProjectedPoint feet = camera.project(p, view);
+      const ProjectedPoint head = camera.project(p + glm::vec3(0.0f, 1.8f, 0.0f), view);
+      places.push_back({{"x", p.x}, {"z", p.z}, {"feet_px", feet.pixel.x},
+                        {"feet_py", feet.pixel.y}, {"head_px", head.pixel.x},
+                        {"head_py", head.pixel.y}, {"in_front", feet.in_front && head.in_front}});
+    }
+    j["followed_places"] = places;  // [0] the right half (primary), [1] the left
   }
   std::ofstream out(path);
   out << j.dump(1) << "\n";
@@ -248,6 +267,7 @@ void run_render(RenderOptions& o) {
   // With --follow the camera rides on the agent: --camera then sets its angles and distance.
   CameraDirector director;
   director.set_overview(scene.view->camera());
+  director.set_view(o.compare ? glm::ivec2(scene.size.x / 2, scene.size.y) : scene.size);
   if (lesson) {
     OrbitCamera overview = director.overview();
     overview.yaw_rad = glm::radians(lesson->yaw_deg);

@@ -222,6 +222,11 @@ Status DemoApp::render_scene(float real_dt_s) {
   OrbitCamera overview = frame_bounds(session_->bounds_min(), session_->bounds_max(), view_size());
   if (overview_yaw_) overview.yaw_rad = *overview_yaw_;
   director_.set_overview(overview);
+  // A twin (the feedback lesson) is framed above the lesson's text box (last frame's).
+  const int text_top = static_cast<int>(lesson_text_rect_.y);
+  director_.set_view(view_size(), lesson_text_rect_.w > 0.0f && text_top > 0
+                                      ? std::max(0, view_size().y - text_top)
+                                      : 0);
   director_.update(session_->crowd().time_s(), real_dt_s,
                    shown_followed(), &camera_);
   view_->camera() = camera_;

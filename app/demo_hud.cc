@@ -28,6 +28,18 @@ void boxed_text(ImDrawList* dl, ImVec2 at, const char* text, float size_px, ImU3
   dl->AddText(font, size_px, at, color, text, nullptr, wrap_px);
 }
 
+// A label above the head projected at `head_px` in the half at `offset_x` of `width` x `height`:
+// kept inside that half (the head may be near or past its edge, e.g. a twin running ahead).
+void above_head(ImDrawList* dl, glm::vec2 head_px, float offset_x, float width, float height,
+                const char* text, float size_px, ImU32 color) {
+  const ImVec2 extent = ImGui::GetFont()->CalcTextSizeA(size_px, 1e9f, 0.0f, text);
+  const float x = std::clamp(head_px.x - 0.5f * extent.x, 8.0f,
+                             std::max(8.0f, width - extent.x - 8.0f));
+  const float y = std::clamp(head_px.y - 1.7f * size_px, 6.0f + 1.6f * size_px,
+                             std::max(6.0f + 1.6f * size_px, height - 2.0f * size_px));
+  boxed_text(dl, ImVec2(offset_x + x, y), text, size_px, color);
+}
+
 }  // namespace
 
 void DemoApp::draw_overlay_text() {
@@ -77,11 +89,11 @@ void DemoApp::draw_overlay_text() {
       const std::optional<TorsoReadout> t = torso_readout(*session_, lane, selected_id_);
       if (!t) return;
       const ProjectedPoint p = camera_.project(t->head, view);
-      if (!p.in_front || p.pixel.x < 0.0f || p.pixel.x > half) return;
+      if (!p.in_front) return;
       std::snprintf(text, sizeof(text), "twist %.0f\xc2\xb0 (limit %.0f\xc2\xb0)",
                     std::abs(t->twist_deg), t->limit_deg);
-      boxed_text(fg, ImVec2(offset_x + p.pixel.x, p.pixel.y - base * 2.2f), text, base * 1.3f,
-                 IM_COL32(255, 200, 120, 255), true);
+      above_head(fg, p.pixel, offset_x, half, static_cast<float>(view.y), text, base * 1.3f,
+                 IM_COL32(255, 200, 120, 255));
     };
     label(session_->lane(), split ? half : 0.0f);
     if (split) label(session_->compare_lane(), 0.0f);
@@ -92,11 +104,11 @@ void DemoApp::draw_overlay_text() {
       const std::optional<LegsReadout> l = legs_readout(*session_, lane, selected_id_);
       if (!l) return;
       const ProjectedPoint p = camera_.project(l->head, view);
-      if (!p.in_front || p.pixel.x < 0.0f || p.pixel.x > half) return;
+      if (!p.in_front) return;
       std::snprintf(text, sizeof(text), "sim %.1f m/s, legs max %.1f", l->speed_m_s,
                     l->legs_max_m_s);
-      boxed_text(fg, ImVec2(offset_x + p.pixel.x, p.pixel.y - base * 2.2f), text, base * 1.3f,
-                 IM_COL32(255, 140, 120, 255), true);
+      above_head(fg, p.pixel, offset_x, half, static_cast<float>(view.y), text, base * 1.3f,
+                 IM_COL32(255, 140, 120, 255));
     };
     label(session_->lane(), split ? half : 0.0f);
     if (split) label(session_->compare_lane(), 0.0f);

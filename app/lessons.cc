@@ -51,26 +51,29 @@ const Lesson kLessons[] = {
     {"playback-rate", "Playback-rate matching", "crossing", 24, 1, 0.5f, true, 110.0f, 7.0f,
      overlays(true, false, false, false, false), "naive", "rate", naive, rate_only, false, true,
      false,
-     "Left, naive: the clip plays at its native rate whatever the agent's speed. Right, rate "
-     "matching only: the clip plays faster or slower so its stride speed equals the walking "
-     "speed. The panel plots the selected agent's stride length and cadence against its speed "
-     "beside the clip's own values; most sliding goes, except in turns and speed changes.",
+     "Left, naive: the clip plays at its native rate whatever the agent's speed, so feet of "
+     "walkers slower or faster than the clip slip (yellow and red ticks). Right, rate matching "
+     "only: the clip plays faster or slower so its stride speed equals the walking speed, and "
+     "steady walkers leave green ticks; turns and speed changes still slip. The panel plots the "
+     "selected agent's stride length and cadence against its speed beside the clip's own values.",
      "RATE MATCHING - CLIP PLAYED AT AGENT SPEED / CLIP SPEED"},
     {"foot-locking", "Foot locking", "crossing", 12, 1, 0.5f, true, 200.0f, 5.0f,
      overlays(true, true, false, false, false), "locking off", "locking on", no_locking, keep,
      false, false, false,
      "Both halves run the whole mediator; only foot locking differs (parameter foot_locking). "
-     "White crosses mark feet pinned in world space by two-bone IK: on the right the toe stays "
-     "on its cross until the clip lifts it, on the left what rate matching leaves still slides, "
-     "most in turns and stops.",
+     "White crosses, on the right only, mark feet pinned in world space by two-bone IK: the toe "
+     "stays on its cross until the clip lifts it. On the left nothing holds the foot: in a "
+     "steady walk it looks the same, but where the walker starts, turns or stops the feet slip "
+     "(red ticks).",
      "FOOT LOCKING - WHITE CROSSES: PINNED FEET"},
     {"torso-decoupling", "Torso decoupling", "gallery", 24, 1, 0.5f, true, 160.0f, 6.0f,
      overlays(false, false, false, true, true), "no twist", "twist 60 deg", no_twist, keep, false,
      false, false,
      "Visitors walk past the exhibits and look at them (yellow: where the agent looks). Right: "
      "the legs follow the walking direction, the upper body turns toward the exhibit within the "
-     "60 degree limit (fan: blue pelvis, orange chest, white arc the limit). Left, no twist "
-     "allowed: the body turns as one piece and cannot look.",
+     "60 degree limit (fan: blue pelvis, orange chest, white arc the limit; the twist is written "
+     "above the head). Left, no twist allowed: pelvis and chest turn as one piece and the chest "
+     "stays off the yellow line.",
      "TORSO DECOUPLING - BLUE PELVIS, ORANGE CHEST, YELLOW LOOK"},
     {"feedback", "Feedback", "rush", 0, 1, 0.5f, true, 90.0f, 7.0f, legs_overlays(), "feedback off",
      "feedback on", walk_speeds_no_feedback, walk_speeds, true, false, true,
@@ -79,8 +82,9 @@ const Lesson kLessons[] = {
      "simulator moves the bodies at running speed while the legs walk, so the feet slide (red "
      "trails). Right: the mediator tells the simulator the speed the legs can deliver; the "
      "runners slow to a fast walk and leave still, green footprints. Above the head: the "
-     "simulator's speed against the legs' maximum; the same agent is ringed on both sides, and "
-     "on the left it is carried ahead of where its legs could take it.",
+     "simulator's speed against the legs' maximum. The same agent is ringed on both sides; one "
+     "camera aims between the two and backs away as the left one is carried ahead of where its "
+     "legs could take it.",
      "FEEDBACK - SIMULATOR SPEED VS WHAT THE LEGS CAN DO (ABOVE THE HEAD)"},
 };
 

@@ -70,13 +70,29 @@ Exhibits make_exhibits(const CrowdSetup& setup, glm::vec2 scene_center, float wa
   return out;
 }
 
-std::optional<FollowedAgent> followed_agent(const CrowdSession& session, int64_t id) {
-  const AgentFrame& frame = session.frame();
-  const auto draws = session.lane().draw_span();
+namespace {
+
+std::optional<FollowedAgent> find_in_lane(const CrowdSession& session, const AnimationLane& lane,
+                                          int64_t id) {
+  const AgentFrame& frame = session.frame_of(lane);
+  const auto draws = lane.draw_span();
   for (size_t i = 0; i < draws.size() && i < frame.size(); ++i) {
     if (frame.ids[i] == id) return FollowedAgent{draws[i].position, frame.velocities[i]};
   }
   return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<FollowedAgent> followed_agent(const CrowdSession& session, int64_t id) {
+  std::optional<FollowedAgent> a = find_in_lane(session, session.lane(), id);
+  if (a && session.has_compare() && session.compare_has_own_crowd()) {
+    if (const std::optional<FollowedAgent> b = find_in_lane(session, session.compare_lane(), id)) {
+      a->twin = b->position;
+      a->velocity_xz = 0.5f * (a->velocity_xz + b->velocity_xz);
+    }
+  }
+  return a;
 }
 
 Result<std::unique_ptr<SceneView>> SceneView::create(const CrowdSession& session) {

@@ -30,7 +30,8 @@ inline constexpr glm::vec3 kExhibitCanvasColor{0.02f, 0.42f, 0.48f};  // linear 
 Exhibits make_exhibits(const CrowdSetup& setup, glm::vec2 scene_center, float wall_thickness_m);
 
 // The agent `id` as drawn by the primary lane (after collect()) with its simulator velocity, or
-// nullopt when it is not in the frame.
+// nullopt when it is not in the frame. When the split's halves run their own crowds, `twin` is
+// where the compare lane draws it and the velocity the mean of the two.
 std::optional<FollowedAgent> followed_agent(const CrowdSession& session, int64_t id);
 
 class SceneView {

@@ -3,6 +3,7 @@
 // simulation runs each half on its own crowd; an unknown name is refused with the list. Without
 // EGL the tests skip with a message, except under CI=true.
 
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -65,6 +66,31 @@ TEST(RenderLesson, FeedbackRunsEachHalfOnItsOwnCrowd) {
   EXPECT_TRUE(j["compare_own_crowd"].get<bool>());
   EXPECT_FALSE(j["compare_params"]["feedback"].get<bool>());
   EXPECT_TRUE(j["params"]["feedback"].get<bool>());
+}
+
+// Without feedback the left half's runner is carried ahead of the right half's walker; one camera
+// shows both halves, so it frames both places: after 5 s, metres apart, both bodies and the
+// space over their heads (the speed labels) are inside the half view.
+TEST(RenderLesson, FeedbackKeepsTheRingedAgentInViewInBothHalves) {
+  const std::string dir = test::scratch_dir("render_lesson_feedback_frame");
+  GK_RUN_RENDER(r, "render --lesson feedback --size 480x270 --frames 300 --out " + dir +
+                       "/feedback.png --report " + dir + "/feedback.json");
+  const nlohmann::json j = read_json(dir + "/feedback.json");
+  ASSERT_TRUE(j.contains("followed_places")) << j.dump();
+  const auto& places = j["followed_places"];
+  ASSERT_EQ(places.size(), 2u);
+  const double apart = std::hypot(places[0]["x"].get<double>() - places[1]["x"].get<double>(),
+                                  places[0]["z"].get<double>() - places[1]["z"].get<double>());
+  EXPECT_GT(apart, 2.0) << "the halves' runners should be apart: the check can fail";
+  for (const auto& p : places) {
+    EXPECT_TRUE(p["in_front"].get<bool>());
+    for (const char* k : {"feet_px", "head_px"}) {
+      EXPECT_GT(p[k].get<double>(), 0.0) << p;
+      EXPECT_LT(p[k].get<double>(), 240.0) << p;
+    }
+    EXPECT_LT(p["feet_py"].get<double>(), 270.0) << p;
+    EXPECT_GT(p["head_py"].get<double>(), 20.0) << "no room for the label over the head: " << p;
+  }
 }
 
 TEST(RenderLesson, AnUnknownLessonIsRefusedWithTheList) {

@@ -130,5 +130,56 @@ TEST(CameraDirector, AUserWhoTakesTheCameraCancelsThePullOut) {
   EXPECT_NEAR(camera.distance_m, 0.5f * kFollowDistance_m, 1e-4f);
 }
 
+// The feedback lesson: the same agent in two halves under one camera, the left one carried 1.2 m/s
+// faster than the right one, seen from behind. Followed alone, the one running ahead leaves the
+// top of the image within seconds; with the twin both stay in view, feet and label, while the
+// camera backs away; a user who zooms keeps the distance they chose.
+TEST(CameraDirector, KeepsBothPlacesOfATwinInView) {
+  const glm::ivec2 view(480, 540);
+  auto run = [&](bool twin, bool zoom, float* worst_top, float* distance) {
+    OrbitCamera camera;
+    camera.yaw_rad = -glm::half_pi<float>();  // behind agents walking along +x
+    CameraDirector director;
+    director.set_view(view);
+    director.set_overview(camera);
+    director.follow(3, 7.0f, kFollowPitch_rad);
+    director.snap();
+    *worst_top = 1e9f;
+    for (int f = 0; f < 600; ++f) {
+      const float t = f * kDt;
+      const glm::vec3 slow(1.8f * t, 0.0f, 0.0f), fast(3.0f * t, 0.0f, 0.0f);
+      FollowedAgent a{slow, {1.8f, 0.0f}};
+      if (twin) a.twin = fast;
+      if (zoom && f == 300) {
+        director.user_took_camera();
+        camera.distance_m = 6.0f;
+      }
+      director.update(t, kDt, a, &camera);
+      if (f >= 300 || zoom) continue;
+      for (const glm::vec3& p : {slow, fast}) {
+        const ProjectedPoint head = camera.project(p + glm::vec3(0.0f, 2.2f, 0.0f), view);
+        const ProjectedPoint feet = camera.project(p, view);
+        ASSERT_TRUE(head.in_front && feet.in_front);
+        *worst_top = std::min(*worst_top, head.pixel.y);
+        if (twin) {
+          EXPECT_LT(feet.pixel.y, view.y) << "frame " << f;
+          EXPECT_GT(head.pixel.x, 0.0f);
+          EXPECT_LT(head.pixel.x, view.x);
+        }
+      }
+    }
+    *distance = camera.distance_m;
+  };
+  float top_alone = 0.0f, top_twin = 0.0f, d_alone = 0.0f, d_twin = 0.0f, d_zoom = 0.0f, unused;
+  run(false, false, &top_alone, &d_alone);
+  run(true, false, &top_twin, &d_twin);
+  run(true, true, &unused, &d_zoom);
+  EXPECT_LT(top_alone, 0.0f) << "alone, the runner ahead leaves the image: the check can fail";
+  EXPECT_GT(top_twin, 0.0f);
+  EXPECT_NEAR(d_alone, 7.0f, 1e-3f);
+  EXPECT_GT(d_twin, 9.0f) << "10 s apart at 1.2 m/s: the camera backed away";
+  EXPECT_NEAR(d_zoom, 6.0f, 1e-3f) << "the user's zoom is kept";
+}
+
 }  // namespace
 }  // namespace gk::app

@@ -126,6 +126,22 @@ TEST(DemoKeys, SpacePausesAndResumesSimulatedTime) {
       run_demo("space2", kFew + "--frames 20 --input 8:key:space --input 14:key:space", kSmall);
   EXPECT_NEAR(resumed.report["time_s"].get<double>(), 14 * kStep_s, 1e-4);
   EXPECT_FALSE(resumed.report["paused"].get<bool>());
+  // The screenshots: paused, the scene (above the status text along the bottom) stands still
+  // from frame 12 to frame 20; running, the crowd has moved on by frame 20.
+  const Shot paused_early = run_demo("space_early", kFew + "--frames 12 --input 8:key:space", kSmall);
+  const Shot running = run_demo("space_running", kFew + "--frames 20", kSmall);
+  const int w = paused.report["scene_width"].get<int>();
+  auto changed = [&](const test::Image& a, const test::Image& b) {
+    int n = 0;
+    for (int y = 40; y < 300; ++y) {
+      for (int x = 0; x < w; ++x) n += test::pixel_difference(a.at(x, y), b.at(x, y)) > 30;
+    }
+    return n;
+  };
+  const int while_paused = changed(paused.image, paused_early.image);
+  const int while_running = changed(running.image, paused_early.image);
+  EXPECT_LT(while_paused, 10) << "the scene moved while paused";
+  EXPECT_GT(while_running, 80) << "the crowd should move in 8 frames: the check can fail";
 }
 
 TEST(DemoKeys, HShowsTheHelpOverTheSceneAndEscQuits) {
@@ -207,6 +223,24 @@ TEST(DemoMouse, AClickSelectsAnAgentAndTheCameraBringsItToTheCentre) {
   EXPECT_TRUE(found);
   // Closing in on it (one second into a move from the overview to 8 m).
   EXPECT_LT(after.report["camera"]["distance_m"].get<double>(), 0.6 * before_m);
+  // The screenshot: the selection ring (magenta) at the clicked agent's feet, now at the centre
+  // of the view; before the click there is no ring anywhere in the scene.
+  auto ring_pixels = [](const test::Image& img, int x0, int y0, int x1, int y1) {
+    int n = 0;
+    for (int y = std::max(0, y0); y < std::min(img.height, y1); ++y) {
+      for (int x = std::max(0, x0); x < x1; ++x) {
+        const glm::u8vec4 c = img.at(x, y);
+        n += c.x > 200 && c.y < 110 && c.z > 170;
+      }
+    }
+    return n;
+  };
+  const int ring_after = ring_pixels(after.image, static_cast<int>(cx) - 100,
+                                     static_cast<int>(cy) - 20, static_cast<int>(cx) + 100,
+                                     static_cast<int>(cy) + 140);
+  const int ring_before = ring_pixels(first.image, 0, 0, scene_w, 450);
+  EXPECT_GT(ring_after, 40) << "no selection ring under the clicked agent";
+  EXPECT_LT(ring_before, 5) << "a ring before anything was selected";
 }
 
 OrbitCamera camera_of(const nlohmann::json& report) {
