@@ -118,14 +118,28 @@ bool enable_overlay(const std::string& n, OverlayToggles* t) {
   return false;
 }
 
-std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
-                                          int64_t agent_id) {
-  const AgentFrame& frame = session.frame_of(lane);
-  const AnimationPlans& plans = lane.plans();
+namespace {
+
+// The frame index of an agent and its plan slot, if it is in the lane's frame with a slot.
+std::optional<std::pair<size_t, int>> find_agent(const AgentFrame& frame,
+                                                  const AnimationPlans& plans, int64_t agent_id) {
   for (size_t i = 0; i < frame.size(); ++i) {
     if (frame.ids[i] != agent_id) continue;
     const int slot = plans.slot_of_agent[i];
     if (slot < 0) return std::nullopt;
+    return std::make_pair(i, slot);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<TorsoReadout> torso_readout(const CrowdSession& session, const AnimationLane& lane,
+                                          int64_t agent_id) {
+  const AgentFrame& frame = session.frame_of(lane);
+  const AnimationPlans& plans = lane.plans();
+  if (const auto found = find_agent(frame, plans, agent_id)) {
+    const auto [i, slot] = *found;
     const glm::vec2 root = plans.root_xz[slot];
     const float pelvis = lane.poses().pelvis_heading(slot);
     TorsoReadout out;
@@ -142,12 +156,11 @@ std::optional<LegsReadout> legs_readout(const CrowdSession& session, const Anima
                                         int64_t agent_id) {
   const AgentFrame& frame = session.frame_of(lane);
   const AnimationPlans& plans = lane.plans();
-  for (size_t i = 0; i < frame.size(); ++i) {
-    if (frame.ids[i] != agent_id) continue;
-    const int slot = plans.slot_of_agent[i];
+  if (const auto found = find_agent(frame, plans, agent_id)) {
+    const auto [i, slot] = *found;
     const glm::vec2 v = frame.velocities[i];
     const float speed = glm::length(v);
-    if (slot < 0 || speed < lane.params().stop_speed_m_s) return std::nullopt;
+    if (speed < lane.params().stop_speed_m_s) return std::nullopt;
     const glm::vec2 root = plans.root_xz[slot];
     LegsReadout out;
     out.head = glm::vec3(root.x, 2.05f, root.y);

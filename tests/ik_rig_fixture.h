@@ -22,6 +22,15 @@ struct IkRigOptions {
   std::vector<std::string> clips = {"idle", "walk_slow", "walk", "walk_fast", "jog"};
 };
 
+// The hard case: meaningless joint names, inches, toes hanging from the root as well.
+inline IkRigOptions meaningless_inch_rig() {
+  IkRigOptions o;
+  o.known_names = false;
+  o.units_per_m = 1.0f / 0.0254f;
+  o.toes_under_root = true;
+  return o;
+}
+
 struct IkRig {
   std::string glb;  // the file's bytes
   // The built-in clips (metres, on the built-in skeleton) that the file holds, in its order.

@@ -20,6 +20,7 @@
 #include "animation/mesh.h"
 #include "animation/pose_jobs.h"
 #include "tests/test_data.h"
+#include "tests/animation/model_pose.h"
 
 namespace gk {
 namespace {
@@ -28,17 +29,7 @@ constexpr const char* kGlb = "clips/gltf/ual_mannequin_quaternius.glb";
 
 std::string fixture(const std::string& rel) { return test::source_path("tests/data/" + rel); }
 
-std::vector<glm::mat4> model_pose(const Skeleton& s, const glm::quat* r, const glm::vec3* t) {
-  std::vector<glm::mat4> model(s.num_joints());
-  LocalToModelJob job;
-  job.skeleton = &s;
-  job.rotations = {r, static_cast<size_t>(s.num_joints())};
-  job.translations = {t, static_cast<size_t>(s.num_joints())};
-  job.out_model = model;
-  EXPECT_TRUE(job.validate());
-  job.run();
-  return model;
-}
+using test::model_pose;
 
 glm::vec3 joint_at(const ClipSet& set, const Clip& clip, int frame, int joint) {
   return glm::vec3(model_pose(*set.skeleton, clip.frame_rotations(frame),

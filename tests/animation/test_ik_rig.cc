@@ -17,21 +17,12 @@
 #include "animation/pose_jobs.h"
 #include "tests/ik_rig_fixture.h"
 #include "tests/test_data.h"
+#include "tests/animation/model_pose.h"
 
 namespace gk {
 namespace {
 
-std::vector<glm::mat4> model_pose(const Skeleton& s, const glm::quat* r, const glm::vec3* t) {
-  std::vector<glm::mat4> model(s.num_joints());
-  LocalToModelJob job;
-  job.skeleton = &s;
-  job.rotations = {r, static_cast<size_t>(s.num_joints())};
-  job.translations = {t, static_cast<size_t>(s.num_joints())};
-  job.out_model = model;
-  EXPECT_TRUE(job.validate());
-  job.run();
-  return model;
-}
+using test::model_pose;
 
 std::string role_joint(const Skeleton& s, JointRole r) {
   return s.has(r) ? s.names[s.role(r)] : "-";
@@ -138,11 +129,7 @@ TEST(IkRig, KnownNamesInCentimetresLoadAsLegChains) {
 // Meaningless names in inches, feet and toes under the root: the roles cannot be found (and
 // nothing is guessed), the manifest gives them, and the legs then load as chains.
 TEST(IkRig, MeaninglessNamesInInchesNeedTheManifest) {
-  test::IkRigOptions o;
-  o.known_names = false;
-  o.units_per_m = 1.0f / 0.0254f;
-  o.toes_under_root = true;
-  const test::IkRig rig = test::make_ik_rig(o);
+  const test::IkRig rig = test::make_ik_rig(test::meaningless_inch_rig());
   Result<ClipSet> bare = parse_gltf(rig.glb, "ik_rig_in.glb");
   ASSERT_TRUE(bare.ok()) << bare.message();
   EXPECT_FALSE(bare->skeleton->has_locomotion_roles());

@@ -54,11 +54,7 @@ TEST(CliIkRig, KnownNamesWorkWithoutAManifest) {
 
 TEST(CliIkRig, MeaninglessNamesAreRefusedThenWorkWithRoles) {
   const std::string dir = test::scratch_dir("cli_ik_rig");
-  test::IkRigOptions o;
-  o.known_names = false;
-  o.units_per_m = 1.0f / 0.0254f;
-  o.toes_under_root = true;
-  const test::IkRig rig = test::make_ik_rig(o);
+  const test::IkRig rig = test::make_ik_rig(test::meaningless_inch_rig());
   const std::string glb = dir + "/ik_rig_in.glb", roles = dir + "/ik_rig_in_roles.json";
   ASSERT_TRUE(test::write_file(glb, rig.glb));
   ASSERT_TRUE(test::write_file(roles, rig.roles_json));

@@ -92,11 +92,7 @@ TEST(IkRigLibrary, AnalysedAndPlantedAsTheClipsItWasWrittenFrom) {
 }
 
 TEST(IkRigLibrary, MeaninglessNamesAreRefusedSayingHowToGiveRoles) {
-  test::IkRigOptions o;
-  o.known_names = false;
-  o.units_per_m = 1.0f / 0.0254f;
-  o.toes_under_root = true;
-  const test::IkRig rig = test::make_ik_rig(o);
+  const test::IkRig rig = test::make_ik_rig(test::meaningless_inch_rig());
   Result<ClipSet> bare = parse_gltf(rig.glb, "ik_rig_in.glb");
   ASSERT_TRUE(bare.ok()) << bare.message();
   std::vector<ClipSet> sets{*bare};
