@@ -403,16 +403,19 @@ Status SocialForces::apply_feedback(const AgentFeedback& fb) {
   const float max_v = params_.max_feedback_speed_m_s, max_jump = params_.max_feedback_jump_m;
   for (size_t i = 0; i < num_; ++i) {  // validate everything before changing anything
     if (!fb.has_feedback[i]) continue;
-    const std::string who = "social forces: feedback for agent id " + std::to_string(id_[i]) + ": ";
+    // The message is built only when there is an error: nothing is allocated per frame.
+    auto who = [&] {
+      return "social forces: feedback for agent id " + std::to_string(id_[i]) + ": ";
+    };
     if (!finite(fb.positions[i]) || !finite(fb.velocities[i]) || !std::isfinite(fb.thetas[i])) {
-      return Status::Error(who + "non-finite position, velocity or theta");
+      return Status::Error(who() + "non-finite position, velocity or theta");
     }
     if (glm::length(fb.velocities[i]) > max_v) {
-      return Status::Error(who + "speed " + std::to_string(glm::length(fb.velocities[i])) +
+      return Status::Error(who() + "speed " + std::to_string(glm::length(fb.velocities[i])) +
                            " m/s exceeds max_feedback_speed_m_s " + std::to_string(max_v));
     }
     if (glm::length(fb.positions[i] - position_[i]) > max_jump) {
-      return Status::Error(who + "position moves " +
+      return Status::Error(who() + "position moves " +
                            std::to_string(glm::length(fb.positions[i] - position_[i])) +
                            " m, more than max_feedback_jump_m " + std::to_string(max_jump));
     }
