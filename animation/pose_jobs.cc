@@ -187,8 +187,10 @@ void TwoBoneIKJob::run() const {
   // Only reach beyond the pose's own is softened: a leg the animation itself stretches that far is
   // reached exactly (it straightens no faster than the animation does).
   float soft_reach = reach;
-  const float soft_start = std::max(max_len * std::clamp(soften, 0.0f, 1.0f),
-                                    std::min(glm::length(c - a), max_len));
+  const glm::vec3 ac = c - a;
+  const float lac = glm::length(ac);
+  const float soft_start =
+      std::max(max_len * std::clamp(soften, 0.0f, 1.0f), std::min(lac, max_len));
   const float soft_span = max_len - soft_start;
   if (soft_span > 1e-6f && reach > soft_start) {
     soft_reach = soft_start + soft_span * (1.0f - std::exp(-(reach - soft_start) / soft_span));
@@ -197,8 +199,7 @@ void TwoBoneIKJob::run() const {
   if (out_reached) *out_reached = reach <= max_len && reach >= min_len;
 
   // Current and desired interior angles.
-  const glm::vec3 ab = glm::normalize(b - a), ac = c - a, bc = glm::normalize(c - b);
-  const float lac = glm::length(ac);
+  const glm::vec3 ab = glm::normalize(b - a), bc = glm::normalize(c - b);
   if (lac < 1e-6f) return;
   const glm::vec3 ac_n = ac / lac;
   const float ac_ab_0 = std::acos(clamp_unit(glm::dot(ac_n, ab)));

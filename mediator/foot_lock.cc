@@ -43,6 +43,10 @@ namespace {
 
 glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams& p, float dt) {
   const glm::vec3 anim_vel = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
+  // The clip's toe speed over the ground, this frame and last (< 0: none yet).
+  const float speed = std::hypot(anim_vel.x, anim_vel.z);
+  const float last_speed = lock.anim_speed;
+  lock.anim_speed = in.fresh ? -1.0f : speed;
   auto lock_here = [&](const glm::vec3& at) {
     lock.state = FootLockState::kLocked;
     // Pinned no higher than it is drawn (a pinned toe never rises) nor than the clip has it, and
@@ -67,9 +71,8 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
       // The clips plant the foot while its ball may still roll down and forward off the heel
       // (and a blend of clips lands a foot over a few frames): it is pinned once the ball has come
       // to rest over the ground, or has stopped slowing down, where it was drawn last frame.
-      const float speed = std::hypot(anim_vel.x, anim_vel.z);
       const bool at_rest = in.fresh || speed <= in.still_speed_m_s ||
-                           (lock.anim_speed >= 0.0f && speed >= lock.anim_speed);
+                           (last_speed >= 0.0f && speed >= last_speed);
       if (in.plant && at_rest) lock_here(in.fresh ? in.anim_toe : in.drawn_toe_prev);
       break;
     }
@@ -161,8 +164,6 @@ glm::vec3 step_foot_lock(FootLock& lock, const FootLockInput& in, const FootLock
     lock.last_goal = in.anim_toe;
   }
   const glm::vec3 goal = advance(lock, in, p, dt);
-  lock.anim_speed =
-      in.fresh ? -1.0f : std::hypot(in.anim_toe.x - in.anim_toe_prev.x, in.anim_toe.z - in.anim_toe_prev.z) / dt;
   lock.goal_vel = in.fresh ? glm::vec3(0.0f) : (goal - lock.last_goal) / dt;
   lock.last_goal = goal;
   return goal;
