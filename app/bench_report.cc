@@ -64,6 +64,7 @@ json to_json(const BenchReport& r) {
       {"clips", r.clips},
       {"takes", r.takes},
       {"left_out", r.left_out},
+      {"doubtful_clips", r.doubtful},
       {"timing_ms", timing},
       {"us_per_agent", or_null(r.us_per_agent)},
       {"metrics", r.metrics ? *r.metrics : json(nullptr)},
@@ -132,6 +133,7 @@ std::string summary(const BenchReport& r) {
     for (const std::string& c : r.clips) s += " " + c;
     for (const std::string& t : r.takes) s += "\n  take " + t;
     for (const std::string& l : r.left_out) s += "\n  left out: " + l;
+    for (const std::string& d : r.doubtful) s += "\n  doubtful: " + d;
     s += "\n  foot slide " + num(m["foot_slide_cm_s"], 2) + " cm/s (p95 " +
          num(m["foot_slide_p95_cm_s"], 2) + ", clips' floor " + num(m["foot_slide_floor_cm_s"], 2) +
          "), skate ratio " + num(m["skate_ratio"], 4) + ", drift " +

@@ -94,6 +94,9 @@ struct BenchReport {
   std::vector<std::string> takes;
   // Clips of the given files that are not in the library: "file: why: clip, clip, ...".
   std::vector<std::string> left_out;
+  // Gait clips whose contact analysis is doubtful, and why: "clip: why; ...; played without foot
+  // locks".
+  std::vector<std::string> doubtful;
   std::array<std::optional<TimingStat>, kNumStages> timing_ms;
   std::optional<double> us_per_agent;     // median total / agents * 1000
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists

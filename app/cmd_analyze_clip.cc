@@ -21,6 +21,7 @@
 #include "app/clip_plot.h"
 #include "app/commands.h"
 #include "app/crowd_setup.h"
+#include "mediator/locomotion_library.h"
 
 namespace gk::app {
 namespace {
@@ -159,6 +160,23 @@ void print_text(const nlohmann::json& j) {
   for (const auto& p : take["problems"]) std::printf("  problem: %s\n", p.get<std::string>().c_str());
 }
 
+// What a library of this file alone keeps (as `--clips FILE` builds it): its clips, the clips
+// whose contacts it cannot trust, and what it leaves out.
+void print_library(const ClipSet& set) {
+  std::vector<ClipSet> one{set};
+  Result<LocomotionLibrary> lib = build_locomotion_library(one);
+  if (!lib.ok()) {
+    std::printf("as a library (%s alone): refused: %s\n", set.source.c_str(),
+                lib.message().c_str());
+    return;
+  }
+  std::printf("as a library (%s alone): %zu clips:", set.source.c_str(), lib->clips.size());
+  for (const std::string& c : lib->clip_names()) std::printf(" %s", c.c_str());
+  std::printf("\n");
+  for (const std::string& d : describe_doubts(*lib)) std::printf("  doubtful: %s\n", d.c_str());
+  for (const std::string& l : describe_left_out(*lib)) std::printf("  left out: %s\n", l.c_str());
+}
+
 int run_analyze(const AnalyzeOptions& opt) {
   std::vector<std::string> files;
   bool builtin = false;
@@ -235,6 +253,7 @@ int run_analyze(const AnalyzeOptions& opt) {
       if (!opt.json) print_text(j);
       all.push_back(std::move(j));
     }
+    if (!opt.json) print_library(set);
   }
   if (opt.json) std::cout << all.dump(2) << "\n";
   if (!plotted.empty()) {

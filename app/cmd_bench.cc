@@ -311,6 +311,7 @@ void run_bench(const BenchOptions& o) {
   report.clips = library.clip_names();
   report.takes = describe_takes(library);
   report.left_out = describe_left_out(library);
+  report.doubtful = describe_doubts(library);
   const MetricsReport measured = metrics.finish();
   report.metrics = metrics_to_json(measured, library);
   if (dump) {

@@ -243,6 +243,13 @@ void run_render(RenderOptions& o) {
   }
   check_output_file_option(kCmd, o.report, "--report");
   std::unique_ptr<CrowdSession> session = CrowdSession::create(o.crowd);
+  // What the library does not use, or uses without trusting its contacts: said before rendering.
+  for (const std::string& l : describe_left_out(session->library())) {
+    std::fprintf(stderr, "render: left out: %s\n", l.c_str());
+  }
+  for (const std::string& d : describe_doubts(session->library())) {
+    std::fprintf(stderr, "render: doubtful: %s\n", d.c_str());
+  }
   if (follow >= 0) check_agent_id(kCmd, session->setup(), follow, "--follow");
   if (kind == OutputKind::kFolder) {
     std::error_code ec;

@@ -197,7 +197,11 @@ void DemoApp::panel_clips() {
   for (const LocomotionClip& c : clips) {
     ImGui::TableNextRow();
     ImGui::TableNextColumn();
-    ImGui::TextUnformatted(c.clip.name.c_str());
+    if (c.doubts.empty()) {
+      ImGui::TextUnformatted(c.clip.name.c_str());
+    } else {
+      ImGui::TextColored(ImVec4(1.0f, 0.7f, 0.3f, 1.0f), "%s (doubtful)", c.clip.name.c_str());
+    }
     ImGui::TableNextColumn();
     ImGui::Text("%.2f", c.speed_m_s);
     ImGui::TableNextColumn();
@@ -212,6 +216,14 @@ void DemoApp::panel_clips() {
     ImGui::Text("left out (%zu clips):", session_->library().left_out.size());
     ImGui::PushTextWrapPos(0.0f);
     for (const std::string& l : left_out) ImGui::TextDisabled("%s", l.c_str());
+    ImGui::PopTextWrapPos();
+  }
+  // Clips whose contacts cannot be trusted are played without foot locks (docs/clips.md).
+  const std::vector<std::string> doubtful = describe_doubts(session_->library());
+  if (!doubtful.empty()) {
+    ImGui::Text("doubtful analysis (%zu clips):", doubtful.size());
+    ImGui::PushTextWrapPos(0.0f);
+    for (const std::string& d : doubtful) ImGui::TextDisabled("%s", d.c_str());
     ImGui::PopTextWrapPos();
   }
 }

@@ -411,6 +411,92 @@ std::vector<std::string> describe_takes(const LocomotionLibrary& library) {
   return out;
 }
 
+std::vector<std::string> gait_doubts(const LocomotionClip& lc) {
+  std::vector<std::string> doubts;
+  const ClipAnalysis& a = lc.analysis;
+  const float duration = lc.clip.duration_s();
+  const bool loops = lc.clip.loops;
+  const float t0 = lc.phase_to_time[0], cycle = lc.cycle_s;
+  if (!(cycle > 0.0f) || duration <= 0.0f) return {"no gait cycle"};
+  const char* names[2] = {"left", "right"};
+  const float half_frame = 0.5f / lc.clip.fps;
+  char buf[256];
+  // Contact starts of each foot inside the cycle [t0, t0 + cycle) (a loop's contacts repeat every
+  // duration), and the time each foot is down in it.
+  std::vector<float> starts[2];
+  float down[2] = {0.0f, 0.0f};
+  for (int s = 0; s < 2; ++s) {
+    for (const TimeInterval& c : a.contacts[s]) {
+      for (int k = loops ? -2 : 0; k <= (loops ? 2 : 0); ++k) {
+        const float b = c.start_s + k * duration, e = c.end_s + k * duration;
+        // Half a frame early: the cycle starts on a landing, and ends where the next one is.
+        if (b >= t0 - half_frame && b < t0 + cycle - half_frame) starts[s].push_back(b);
+        down[s] += std::max(0.0f, std::min(e, t0 + cycle) - std::max(b, t0));
+      }
+    }
+    std::sort(starts[s].begin(), starts[s].end());
+  }
+  // A stride holds one landing of each foot.
+  for (int s = 0; s < 2; ++s) {
+    if (starts[s].size() != 1) {
+      std::snprintf(buf, sizeof(buf),
+                    "its cycle of %.2f s holds %zu landings of the %s foot (one stride holds one "
+                    "of each foot)",
+                    cycle, starts[s].size(), names[s]);
+      doubts.emplace_back(buf);
+    }
+  }
+  // The feet take turns half a stride apart (a limp shifts that a little, a hop or a gallop
+  // lands both together).
+  if (starts[0].size() == 1 && starts[1].size() == 1) {
+    float offset = std::fmod((starts[1][0] - starts[0][0]) / cycle, 1.0f);
+    if (offset < 0.0f) offset += 1.0f;
+    if (offset < 0.25f || offset > 0.75f) {
+      std::snprintf(buf, sizeof(buf),
+                    "the right foot lands %.0f%% of a stride after the left (feet that take "
+                    "turns land about 50%% apart)",
+                    100.0f * offset);
+      doubts.emplace_back(buf);
+    }
+  }
+  // Over the whole clip, between two landings of one foot the other foot lands.
+  std::vector<std::pair<float, int>> all;
+  for (int s = 0; s < 2; ++s) {
+    for (const TimeInterval& c : a.contacts[s]) all.emplace_back(c.start_s, s);
+  }
+  std::sort(all.begin(), all.end());
+  for (size_t i = 1; i < all.size(); ++i) {
+    if (all[i].second != all[i - 1].second) continue;
+    std::snprintf(buf, sizeof(buf),
+                  "contacts do not alternate: the %s foot lands at %.2f s and %.2f s with no "
+                  "landing of the other between",
+                  names[all[i].second], all[i - 1].first, all[i].first);
+    doubts.emplace_back(buf);
+    break;
+  }
+  // Both feet of a gait are down about as long (a walk about 60% of the stride each, a run 35%).
+  const float longer = std::max(down[0], down[1]), shorter = std::min(down[0], down[1]);
+  if (longer > 0.0f && shorter < 0.5f * longer) {
+    std::snprintf(buf, sizeof(buf),
+                  "the left foot is down %.2f s of the stride and the right %.2f s (the feet of "
+                  "a gait are down about as long)",
+                  down[0], down[1]);
+    doubts.emplace_back(buf);
+  }
+  return doubts;
+}
+
+std::vector<std::string> describe_doubts(const LocomotionLibrary& library) {
+  std::vector<std::string> lines;
+  for (const LocomotionClip& c : library.clips) {
+    if (c.doubts.empty()) continue;
+    std::string line = c.clip.name + ": ";
+    for (size_t i = 0; i < c.doubts.size(); ++i) line += (i ? "; " : "") + c.doubts[i];
+    lines.push_back(std::move(line) + "; played without foot locks");
+  }
+  return lines;
+}
+
 std::vector<std::string> describe_left_out(const LocomotionLibrary& library) {
   std::vector<std::string> lines;
   std::vector<std::pair<std::string, std::string>> keys;  // (file, why) in order of appearance
@@ -623,6 +709,14 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     if (!lc.clip.loops) lc.cycle_start_s = lc.analysis.cycle.start_s;
     if (!build_phase_table(&lc)) {
       return leave_out(lc.clip, "no full gait cycle (the contacts do not make one stride)");
+    }
+    lc.doubts = gait_doubts(lc);
+    if (!lc.doubts.empty()) {
+      // Played as captured: no lock is planted or held on contacts that cannot be trusted.
+      for (int s = 0; s < 2; ++s) {
+        std::fill(lc.plant[s].begin(), lc.plant[s].end(), uint8_t{0});
+        std::fill(lc.hold[s].begin(), lc.hold[s].end(), uint8_t{0});
+      }
     }
     lib.clips.push_back(std::move(lc));
   };

@@ -46,6 +46,12 @@ struct LocomotionClip {
   std::vector<float> swing_progress[2];
   float toe_floor_m[2] = {0.0f, 0.0f};     // lowest toe height in the clip
   float ankle_floor_m[2] = {0.0f, 0.0f};   // lowest ankle height in the clip
+  // Why this gait clip's contact analysis is doubtful (empty when it is sound): contacts that do
+  // not alternate, a cycle that is not one stride, feet down for very different times. A doubtful
+  // clip is still played (its speed and cycle are usable), but no foot lock is planted on its
+  // contacts: pinning a foot where the clip is not standing makes legs snap, which is worse than
+  // the clip's own motion.
+  std::vector<std::string> doubts;
   float time_at_phase(float phase) const;  // phase in [0, 1)
 };
 
@@ -103,6 +109,13 @@ struct LocomotionLibrary {
 
 // The clips left out, one line per file and reason: "file: why: clip, clip, ...".
 std::vector<std::string> describe_left_out(const LocomotionLibrary& library);
+
+// The gait clips whose contact analysis is doubtful, one line per clip: "clip: why; why".
+std::vector<std::string> describe_doubts(const LocomotionLibrary& library);
+
+// Why a gait clip's analysis is doubtful (see LocomotionClip::doubts); empty when it is sound.
+// Needs the clip's analysis and phase table.
+std::vector<std::string> gait_doubts(const LocomotionClip& clip);
 
 // One line per segmented take: its segments (kind and span), the clips cut from it, and its problems.
 std::vector<std::string> describe_takes(const LocomotionLibrary& library);
