@@ -28,7 +28,7 @@ void release_foot_lock(FootLock& lock, const glm::vec3& drawn_toe, const glm::ve
   lock.offset = drawn_toe - anim_toe;
   lock.offset_vel = drawn_vel - anim_vel;
 
-  lock.shed = lock.shed_from = lock.shed_goal = lock.released_s = 0.0f;
+  lock.shed = lock.shed_from = lock.shed_goal = lock.released_s = lock.release_time_s = 0.0f;
   lock.swing_from = -1.0f;  // taken from the first frame's progress
 }
 
@@ -104,6 +104,14 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
     case FootLockState::kReleasing: {
       // Shed in the swing's progress from where the release began (a progress that went back,
       // as when the blend changes clips, restarts the count from there: never a jump).
+      if (lock.swing_from < 0.0f) {
+        // Smoothstep's speed peaks at 1.5 times its mean: at the clips' swing speed at most.
+        const float across = std::hypot(lock.offset.x, lock.offset.z);
+        lock.release_time_s = 2.0f * p.release_halflife_s;
+        if (p.swing_speed_m_s > 0.0f) {
+          lock.release_time_s = std::max(lock.release_time_s, 1.5f * across / p.swing_speed_m_s);
+        }
+      }
       if (lock.swing_from < 0.0f || in.swing_progress + 0.05f < lock.swing_from) {
         lock.swing_from = std::min(in.swing_progress, 0.9f);
         lock.shed_from = lock.shed_goal;
@@ -114,7 +122,7 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
       // A release late in the swing still takes its time (twice the halflife at least), not a
       // frame or two; it may then land before the offset is gone, and is pinned where it is.
       lock.released_s += dt;
-      const float by_time = smoothstep01(lock.released_s / (2.0f * p.release_halflife_s));
+      const float by_time = smoothstep01(lock.released_s / lock.release_time_s);
       lock.shed = std::max(lock.shed, std::min(lock.shed_goal, by_time));
       // Upward the foot follows the clip's lift at once (a spring, so the knee does not snap);
       // sideways it is corrected over the swing.
@@ -141,7 +149,16 @@ glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams&
       lock.timer_s += dt;
       const float u = std::min(1.0f, lock.timer_s / p.step_time_s);
       const float s = std::sin(std::numbers::pi_v<float> * u);
-      const glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
+      glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
+      // Where it lands is chosen before it comes down: it follows the clip's foot while it is
+      // carried, and is set down on the spot it was carried to (a body turning on the spot would
+      // otherwise drag the landing foot along the ground).
+      if (u < 1.0f - kStepLift) {
+        lock.step_to = to;
+      } else {
+        to.x = lock.step_to.x;
+        to.z = lock.step_to.z;
+      }
       glm::vec3 goal =
           glm::mix(lock.from, to, smoothstep01((u - kStepLift) / (1.0f - 2.0f * kStepLift)));
       goal.y = glm::mix(lock.from.y, to.y, smoothstep01(u)) + p.step_height_m * s * s;

@@ -28,6 +28,7 @@ struct FootLock {
   glm::vec3 offset_vel{0.0f};  // its rate [m/s]
   glm::vec3 from{0.0f};        // stepping: where the step started [m]
   float timer_s = 0.0f;        // stepping: time since the step started [s]
+  glm::vec3 step_to{0.0f};     // stepping: where it is set down (chosen as it starts to lower) [m]
   glm::vec3 last_goal{0.0f};   // the goal returned last frame [m]
   glm::vec3 goal_vel{0.0f};    // its velocity [m/s] (a step turned release keeps its speed)
   float shed = 0.0f;           // releasing: share of the release offset shed so far, 0..1
@@ -35,6 +36,7 @@ struct FootLock {
   float shed_from = 0.0f;      // releasing: share shed when that progress was taken
   float shed_goal = 0.0f;      // releasing: share the swing's progress asks for
   float released_s = 0.0f;     // releasing: time since the release [s]
+  float release_time_s = 0.0f; // releasing: the shortest time to shed the offset in [s]
   float anim_speed = -1.0f;    // the clip's toe speed over the ground last frame [m/s] (< 0: none)
 };
 
@@ -63,6 +65,9 @@ struct FootLockParams {
   float step_distance_m = 0.25f;     // [m] a pinned foot this far from the clip's re-plants
   float step_time_s = 0.35f;         // [s] duration of a re-planting step
   float step_height_m = 0.05f;       // [m] its height (the clips' own swing)
+  // [m/s] the clips' own peak swing speed: a released foot is never carried faster than this
+  // toward the clip's foot (a long offset takes longer to shed; <= 0: no limit).
+  float swing_speed_m_s = 0.0f;
 };
 
 // Advances one foot by dt_s and returns where its toe should be drawn (world, before any pelvis

@@ -908,6 +908,33 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       }
     }
     if (!peaks.empty()) lib.swing_height_m = percentile(std::move(peaks), 0.5);
+    // Swing speed: the peak horizontal speed of the toe over the ground in each swing of that
+    // clip, played at its native speed (the median over its swings).
+    {
+      const int nf = slow.clip.num_frames;
+      const glm::vec3 travel = slow.speed_m_s * glm::vec3(std::sin(slow.direction_rad), 0.0f,
+                                                          std::cos(slow.direction_rad));
+      std::vector<glm::mat4> model(sk.num_joints());
+      std::vector<glm::vec3> toe[2];
+      for (int f = 0; f < nf; ++f) {
+        clip_frame_model(slow.clip, sk, f, model);
+        for (int s = 0; s < 2; ++s) toe[s].push_back(translation_of(model[sk.toe(static_cast<Side>(s))]));
+      }
+      std::vector<float> speeds;
+      for (int s = 0; s < 2; ++s) {
+        for (const auto& [first, len] : swing_runs(slow.plant[s], slow.clip.loops)) {
+          float peak = 0.0f;
+          for (int k = 0; k + 1 < len; ++k) {
+            const int f = (first + k) % nf, g = (first + k + 1) % nf;
+            if (g < f) continue;  // across a loop's wrap: no reliable difference
+            const glm::vec3 v = (toe[s][g] - toe[s][f]) * slow.clip.fps + travel;
+            peak = std::max(peak, std::hypot(v.x, v.z));
+          }
+          if (peak > 0.0f) speeds.push_back(peak);
+        }
+      }
+      if (!speeds.empty()) lib.swing_speed_m_s = percentile(std::move(speeds), 0.5);
+    }
   }
   for (int s = 0; s < 2; ++s) {
     lib.toe_floor_m[s] = 1e9f;

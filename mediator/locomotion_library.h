@@ -93,6 +93,9 @@ struct LocomotionLibrary {
   // How high the slowest forward clip lifts a toe above planted_toe_m in swing (median of its
   // swings) [m]: the height of a re-planting step.
   float swing_height_m = 0.05f;
+  // How fast the slowest forward clip moves a toe at the peak of its swing, over the ground at
+  // its native speed (median of its swings) [m/s]: the fastest a released foot is carried.
+  float swing_speed_m_s = 3.0f;
   // Largest per-frame change of any joint's local rotation over all source clips, resampled to
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;

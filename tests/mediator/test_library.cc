@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 
@@ -141,6 +143,39 @@ TEST(LocomotionLibrary, RetargetedBonesPointWhereTheSourceBonesPoint) {
     }
   }
   EXPECT_LT(worst, 5.0f);
+}
+
+}  // namespace
+}  // namespace gk
+
+namespace gk {
+namespace {
+
+// The released foot's speed limit: the peak speed of a swinging toe over the ground, which is at
+// least its mean over the swing (a stride's length over the time the foot is off the ground)
+// and, for a smooth swing, less than three times it.
+TEST(LocomotionLibrary, SwingSpeedPeaksAboveTheMeanSpeedOfTheSwing) {
+  std::vector<LocomotionLibrary> libs;
+  libs.push_back(test::builtin_library());
+  for (const char* f : {"clips/bvh/cmu_07_01_walk.bvh", "clips/gltf/ual_mannequin_quaternius.glb",
+                        "clips/bvh/more/cmu_16_15_walk_mrl30.bvh"}) {
+    if (!std::filesystem::exists(test::data_path(f))) continue;
+    auto lib = test::load_data_library({f});
+    ASSERT_TRUE(lib.ok()) << lib.message();
+    libs.push_back(std::move(*lib));
+  }
+  for (const LocomotionLibrary& lib : libs) {
+    const LocomotionClip& slow = lib.clips[lib.groups[lib.forward_group].clips.front()];
+    // The share of its frames on which the left foot is off the ground, by the plant flags the
+    // swing speed was measured between (the clip is a loop of one stride).
+    ASSERT_TRUE(slow.clip.loops) << slow.clip.name;
+    const int cycle = slow.clip.num_frames;
+    const int off = static_cast<int>(std::count(slow.plant[0].begin(), slow.plant[0].end(), 0));
+    ASSERT_GT(off, 0) << slow.clip.name;
+    const float mean_swing = slow.speed_m_s * cycle / static_cast<float>(off);
+    EXPECT_GE(lib.swing_speed_m_s, mean_swing) << slow.clip.name;
+    EXPECT_LE(lib.swing_speed_m_s, 3.0f * mean_swing) << slow.clip.name;
+  }
 }
 
 }  // namespace
