@@ -450,7 +450,13 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
     if (clip.double_support) walk += lw[k];
     for (int s = 0; s < 2; ++s) {
       plant[s] += lw[k] * clip.plant[s][f];
-      if (!clip.swing_progress[s].empty()) swing[s] += lw[k] * clip.swing_progress[s][f];
+      if (!clip.swing_progress[s].empty()) {
+        // Between frames, as the toe heights (a 30 fps clip must not advance the swing, and the
+        // release that follows it, every other frame); not across a landing, where it restarts.
+        const auto& sp = clip.swing_progress[s];
+        const float a = sp[wrap(f0)], b = sp[wrap(f0 + 1)];
+        swing[s] += lw[k] * (b >= a ? a + fu * (b - a) : sp[f]);
+      }
       hold[s] += lw[k] * clip.hold[s][f];
     }
   }

@@ -1,0 +1,49 @@
+// The swing progress the mediator hands to the foot lock advances every frame, also with clips
+// of fewer frames per second than the simulation: the release of a lifted foot follows it, and
+// a progress that stood still every other frame carried the foot in jerks.
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "mediator/mediator.h"
+#include "tests/mediator/mediator_fixture.h"
+#include "tests/test_data.h"
+
+namespace gk {
+namespace {
+
+TEST(SwingProgress, AdvancesEveryFrameWithA30FpsClip) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
+  auto lib = test::load_data_library({"clips/bvh/more/cmu_16_15_walk_mrl30.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  ASSERT_FLOAT_EQ(lib->clips[lib->groups[lib->forward_group].clips.front()].clip.fps, 30.0f);
+  constexpr float kDt = 1.0f / 60.0f;
+  const float speed = lib->clips[lib->groups[lib->forward_group].clips.front()].speed_m_s;
+  Mediator m(*lib, MediatorParams{}, 1);
+  const uint32_t id = 1;
+  glm::vec2 pos(0.0f), vel(0.0f, speed);
+  const float theta = 0.0f;
+  float prev[2] = {-1.0f, -1.0f};
+  int swinging = 0, stalled = 0;
+  for (int f = 0; f < 240; ++f) {
+    pos += vel * kDt;
+    ASSERT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt).ok());
+    const AnimationPlans& pl = m.plans();
+    const int slot = pl.slot_of_agent[0];
+    for (int s = 0; s < 2; ++s) {
+      const float p = pl.swing_progress[s][slot];
+      // Mid-swing, after the blend has settled on the walk (the first second).
+      if (f >= 60 && p > 0.05f && p < 0.95f && prev[s] > 0.05f && prev[s] < 0.95f) {
+        ++swinging;
+        if (std::abs(p - prev[s]) < 1e-6f) ++stalled;
+      }
+      prev[s] = p;
+    }
+  }
+  EXPECT_GT(swinging, 40);
+  EXPECT_EQ(stalled, 0) << "of " << swinging << " mid-swing frames";
+}
+
+}  // namespace
+}  // namespace gk
