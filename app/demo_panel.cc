@@ -218,7 +218,7 @@ void DemoApp::panel_clips() {
     for (const std::string& l : left_out) ImGui::TextDisabled("%s", l.c_str());
     ImGui::PopTextWrapPos();
   }
-  // Clips whose contacts cannot be trusted are played without foot locks (docs/clips.md).
+  // Clips whose contacts cannot be trusted are played without foot locks (README: analyze-clip).
   const std::vector<std::string> doubtful = describe_doubts(session_->library());
   if (!doubtful.empty()) {
     ImGui::Text("doubtful analysis (%zu clips):", doubtful.size());
