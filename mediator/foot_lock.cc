@@ -57,8 +57,8 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
       // The clips plant the foot while its ball may still roll down and forward off the heel
       // (and a blend of clips lands a foot over a few frames): it is pinned once the ball has come
       // to rest over the ground, or has stopped slowing down, where it was drawn last frame.
-      const bool at_rest = in.fresh || speed <= in.still_speed_m_s ||
-                           (last_speed >= 0.0f && speed >= last_speed);
+      const bool at_rest =
+          in.fresh || speed <= in.still_speed_m_s || (last_speed >= 0.0f && speed >= last_speed);
       return in.plant && at_rest ? plant_foot(s, in) : s;
     }
     case FootLockState::kLocked: {
@@ -105,8 +105,7 @@ FootLockStep releasing_foot(const FootLock& s, const FootLockInput& in, const Fo
     out.shed_from = out.shed_goal;
   }
   const float u = (in.swing_progress - out.swing_from) / (1.0f - out.swing_from);
-  out.shed_goal =
-      std::max(out.shed_goal, out.shed_from + (1.0f - out.shed_from) * smoothstep01(u));
+  out.shed_goal = std::max(out.shed_goal, out.shed_from + (1.0f - out.shed_from) * smoothstep01(u));
   // A release late in the swing still takes its time (twice the halflife at least), not a frame
   // or two; it may then land before the offset is gone, and is pinned where it is.
   out.released_s += dt;

@@ -61,7 +61,7 @@ struct FootLockInput {
   // weight (its lock) until the other has taken it over, as a trailing foot stays down until the
   // leading one is flat. (Running has a flight phase: no such wait.)
   bool other_landing = false;
-  float floor_toe_m = 0.0f;        // where planted toes are (library floor) [m]
+  float floor_toe_m = 0.0f;  // where planted toes are (library floor) [m]
   // A ball this slow over the ground is at rest (clip analysis's "still": half the travel speed,
   // at least its capture-jitter floor) [m/s]. A plant pins the foot once its ball is at rest, or
   // once it has stopped slowing down: at its slowest, so the drawn foot stops with no jolt.

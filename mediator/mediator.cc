@@ -182,13 +182,12 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   filter_pass(crowd, frame, pl.root_xz, {vel_, vel_rate_, theta_, theta_rate_},
               {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
   root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_);
-  facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw,
-              pl.upper_yaw, rel_dir_);
+  facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw, pl.upper_yaw,
+              rel_dir_);
   weights_pass(crowd, pl.speed_m_s, rel_dir_, {clip_weights_, scratch_target_}, pl.layer_clip,
                pl.layer_weight, pl.blend_progress);
-  rate_phase_pass(crowd, pl.layer_clip, pl.layer_weight, pl.speed_m_s, cadence_scale_,
-                  pl.lower_yaw, pl.phase, idle_time_, pl.playback_rate, pl.gait_weight,
-                  pl.travel_yaw);
+  rate_phase_pass(crowd, pl.layer_clip, pl.layer_weight, pl.speed_m_s, cadence_scale_, pl.lower_yaw,
+                  pl.phase, idle_time_, pl.playback_rate, pl.gait_weight, pl.travel_yaw);
   contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, pl.gait_weight,
                 pl.layer_time_s,
                 {{pl.plant[0], pl.plant[1]},
@@ -196,10 +195,10 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                  {pl.swing_progress[0], pl.swing_progress[1]},
                  {pl.gait_toe_y[0], pl.gait_toe_y[1]},
                  pl.double_support});
-  feedback_pass(crowd, params_.feedback && policy == FeedbackPolicy::kHonoured, sim_pos_,
-                sim_vel_, sim_theta_, pl.lower_yaw, pl.standing, pl.gait_weight,
-                {feedback_.has_feedback, feedback_.positions, feedback_.velocities,
-                 feedback_.thetas});
+  feedback_pass(
+      crowd, params_.feedback && policy == FeedbackPolicy::kHonoured, sim_pos_, sim_vel_,
+      sim_theta_, pl.lower_yaw, pl.standing, pl.gait_weight,
+      {feedback_.has_feedback, feedback_.positions, feedback_.velocities, feedback_.thetas});
   return Status::Ok();
 }
 

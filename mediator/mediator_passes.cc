@@ -158,8 +158,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
     } else {
       root_xz[slot] = p;
     }
-    out_root_heading[slot] = standing[slot] ? lower_yaw[slot]
-                                            : heading2(glm::length(root_vel) > 1e-3f ? root_vel : vel);
+    out_root_heading[slot] =
+        standing[slot] ? lower_yaw[slot] : heading2(glm::length(root_vel) > 1e-3f ? root_vel : vel);
   });
 }
 

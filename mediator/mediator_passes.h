@@ -3,7 +3,7 @@
 // manner of DetourCrowd's dtCrowd::update: one phase over the whole crowd after the other):
 //
 //   filter    the simulator's p, v, theta sanitised and smoothed   (per agent -> per slot)
-//   root      the drawn root pulled onto p, the travel direction
+//   root      the drawn root pulled onto p, and its heading
 //   facing    lower-body yaw (psi), upper-body yaw, travel direction relative to psi
 //   weights   target clip weights, faded, cut to the heaviest kMaxBlendLayers layers
 //   rate      playback rate and gait phase
@@ -28,9 +28,10 @@
 
 namespace gk {
 
-// What every pass sees: the library, the parameters, the step, and the agents to run over. The
-// passes visit agent i in slot slot_of_agent[i] for i < slot_of_agent.size(); this is the one place
-// that chooses which agents a frame plans (a level of detail would narrow it here).
+// What every pass sees: the library, the parameters, the step, and the agents to run over. Every
+// pass visits the frame's agent i in slot slot_of_agent[i], for i < slot_of_agent.size(), through
+// one loop (for_each_agent in mediator_passes.cc): a level of detail that plans only the agents
+// due this frame would skip the others there, in one place.
 struct PassCrowd {
   const LocomotionLibrary& library;
   const MediatorParams& params;
@@ -40,8 +41,8 @@ struct PassCrowd {
 };
 
 // The simulator's values are garbage beyond these (NaN, 1e30, a velocity no body has).
-inline constexpr float kAbsurdSpeed = 15.0f;     // [m/s]
-inline constexpr float kMaxCoordinate = 1e6f;    // [m] from the origin: a float cannot hold a step
+inline constexpr float kAbsurdSpeed = 15.0f;   // [m/s]
+inline constexpr float kMaxCoordinate = 1e6f;  // [m] from the origin: a float cannot hold a step
 inline bool finite2(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 inline bool usable_position(const glm::vec2& p) {
   return finite2(p) && std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate;

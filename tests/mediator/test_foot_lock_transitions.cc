@@ -29,8 +29,8 @@ void expect_defined(const FootLock& s, const char* what) {
   for (const glm::vec3& v : {s.target, s.offset, s.offset_vel, s.from, s.last_goal, s.goal_vel}) {
     EXPECT_TRUE(finite(v)) << what;
   }
-  for (float x : {s.timer_s, s.shed, s.swing_from, s.shed_from, s.shed_goal, s.released_s,
-                  s.anim_speed}) {
+  for (float x :
+       {s.timer_s, s.shed, s.swing_from, s.shed_from, s.shed_goal, s.released_s, s.anim_speed}) {
     EXPECT_TRUE(std::isfinite(x)) << what;
   }
 }
@@ -248,8 +248,7 @@ TEST(FootLockTransition, LateReleaseStillTakesTwiceTheHalflife) {
 TEST(FootLockTransition, TheClipsLiftingAStepReleasesItFromWhereItIsAtItsSpeed) {
   // Stepping, last drawn at F moving at V; the clips lift the foot (no hold): released from F
   // toward the clip's toe A, the offset F - A, its rate V - (the clip's toe speed).
-  FootLock s = start_foot_step(locked_at({0.0f, kFloor, 0.0f}),
-                               {0.0f, kFloor, 0.0f});
+  FootLock s = start_foot_step(locked_at({0.0f, kFloor, 0.0f}), {0.0f, kFloor, 0.0f});
   s.last_goal = {0.1f, 0.05f, 0.0f};
   s.goal_vel = {1.0f, 0.2f, 0.0f};
   const glm::vec3 a(0.3f, 0.04f, 0.0f), a_prev(0.28f, 0.04f, 0.0f);
@@ -312,13 +311,27 @@ TEST(FootLockTransition, NaNInputGivesADefinedStateAndNoNaN) {
         in.swing_progress = 0.5f;
         float dt = kDt;
         switch (field) {
-          case 0: in.anim_toe.x = kNaN; break;
-          case 1: in.anim_toe_prev.y = kNaN; break;
-          case 2: in.drawn_toe_prev.z = std::numeric_limits<float>::infinity(); break;
-          case 3: in.floor_toe_m = kNaN; break;
-          case 4: in.swing_progress = kNaN; break;
-          case 5: in.still_speed_m_s = kNaN; break;
-          case 6: dt = kNaN; break;
+          case 0:
+            in.anim_toe.x = kNaN;
+            break;
+          case 1:
+            in.anim_toe_prev.y = kNaN;
+            break;
+          case 2:
+            in.drawn_toe_prev.z = std::numeric_limits<float>::infinity();
+            break;
+          case 3:
+            in.floor_toe_m = kNaN;
+            break;
+          case 4:
+            in.swing_progress = kNaN;
+            break;
+          case 5:
+            in.still_speed_m_s = kNaN;
+            break;
+          case 6:
+            dt = kNaN;
+            break;
         }
         const FootLockStep next = step_foot_lock(s, in, p, dt);
         expect_defined(next.state, "after an unusable input");
