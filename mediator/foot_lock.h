@@ -69,10 +69,11 @@ struct FootLockInput {
 };
 
 struct FootLockParams {
-  float release_halflife_s = 0.06f;  // [s] halflife of the released foot's offset
-  float step_distance_m = 0.25f;     // [m] a pinned foot this far from the clip's re-plants
-  float step_time_s = 0.35f;         // [s] duration of a re-planting step
-  float step_height_m = 0.05f;       // [m] its height (the clips' own swing)
+  // [s] halflife of a landing foot's offset; a release sheds its offset in no less than twice it
+  float release_halflife_s = 0.06f;
+  float step_distance_m = 0.25f;  // [m] a pinned foot this far from the clip's re-plants
+  float step_time_s = 0.35f;      // [s] duration of a re-planting step
+  float step_height_m = 0.05f;    // [m] its height (the clips' own swing)
 };
 
 // One frame of one foot: its next state and where its toe should be drawn (world, before any
@@ -84,9 +85,10 @@ struct FootLockStep {
 
 // Advances one foot by dt_s [s]: the state's transition for this input (plant, release, step), then
 // where the foot is drawn in its new state. Unusable input (NaN, infinities, coordinates beyond
-// 1e6 m, dt_s not > 0) never reaches the state: without a usable clip toe or time step the foot
-// keeps its state and its last goal; an unusable previous toe counts as the clip's toe this frame,
-// an unusable floor as none, an unusable swing progress or still speed as 0.
+// 1e6 m, a dt_s that is not a finite positive number) never reaches the state: without a usable
+// clip toe or time step the foot keeps its state and its last goal (a fresh one is a default
+// FootLock drawn at the origin); an unusable previous toe counts as the clip's toe this frame, an
+// unusable floor as none, an unusable swing progress or still speed as 0.
 FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& in,
                             const FootLockParams& params, float dt_s);
 
@@ -95,7 +97,7 @@ FootLock fresh_foot_lock(const glm::vec3& anim_toe);
 
 // Pins the foot where it was drawn last frame (the clip's toe on a fresh frame), no higher than
 // drawn nor than the clip has it and never below the floor; a foot drawn above that settles onto
-// it through the offset.
+// it through the offset. Expects usable input (step_foot_lock replaces what is not).
 FootLock plant_foot(const FootLock& state, const FootLockInput& in);
 
 // Starts a re-planting step of a pinned foot from where it is drawn (from): used when the leg

@@ -45,6 +45,9 @@ void expect_same(const FootLock& a, const FootLock& b) {
   EXPECT_EQ(a.last_goal, b.last_goal);
   EXPECT_EQ(a.goal_vel, b.goal_vel);
   EXPECT_EQ(a.shed, b.shed);
+  EXPECT_EQ(a.swing_from, b.swing_from);
+  EXPECT_EQ(a.shed_from, b.shed_from);
+  EXPECT_EQ(a.shed_goal, b.shed_goal);
   EXPECT_EQ(a.released_s, b.released_s);
   EXPECT_EQ(a.anim_speed, b.anim_speed);
 }
@@ -191,7 +194,8 @@ TEST(FootLockTransition, ReleasingFootReplantsAtTheDrawnPositionAndSettles) {
 TEST(FootLockTransition, ReleaseShedsTheOffsetOverTheSwingWithNoJump) {
   // Pinned at the origin while the clip's toe is 0.3 m ahead; the clips lift the foot and swing
   // it over N = 30 frames (0.5 s), progress k / N, the toe 2 cm further each frame, level on the
-  // first frame (so no vertical offset arises). The header's rule: shed = min(smoothstep(k / N),
+  // first frame (so no vertical offset arises). foot_lock.h's rule (smooth in the swing's progress,
+  // in no less than twice the halflife): shed = min(smoothstep(k / N),
   // smoothstep(t / (2 halflife))), t = (k + 1) dt the time since the release (both rise, so the
   // running maximum is the current value); the goal is the clip's toe plus the offset
   // (0 - 0.3) (1 - shed), and the foot is free once shed reaches 1.
