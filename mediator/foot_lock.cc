@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <glm/common.hpp>
@@ -13,177 +14,241 @@ namespace {
 
 // Share of a re-planting step spent lifting the foot before it moves (and setting it down after).
 constexpr float kStepLift = 0.2f;
+// [m] Coordinates beyond this are garbage, not a place (as the mediator's input check).
+constexpr float kMaxCoordinate = 1e6f;
 
-// Decays an inertialization offset toward zero (Holden's decay spring: exact for any dt).
-void decay_offset(glm::vec3& x, glm::vec3& v, float halflife_s, float dt) {
-  critical_spring(x, v, glm::vec3(0.0f), halflife_s, dt);
+bool usable(float x) { return std::isfinite(x) && std::abs(x) <= kMaxCoordinate; }
+bool usable(const glm::vec3& v) { return usable(v.x) && usable(v.y) && usable(v.z); }
+
+// The input with unusable values replaced as step_foot_lock documents (anim_toe is usable).
+FootLockInput sanitised(const FootLockInput& in) {
+  FootLockInput out = in;
+  if (!usable(out.anim_toe_prev)) out.anim_toe_prev = out.anim_toe;
+  if (!usable(out.drawn_toe_prev)) out.drawn_toe_prev = out.anim_toe;
+  if (!usable(out.floor_toe_m)) out.floor_toe_m = std::numeric_limits<float>::lowest();
+  if (!std::isfinite(out.swing_progress)) out.swing_progress = 0.0f;
+  if (!std::isfinite(out.still_speed_m_s)) out.still_speed_m_s = 0.0f;
+  return out;
 }
 
-}  // namespace
-
-void release_foot_lock(FootLock& lock, const glm::vec3& drawn_toe, const glm::vec3& drawn_vel,
-                       const glm::vec3& anim_toe, const glm::vec3& anim_vel) {
-  lock.state = FootLockState::kReleasing;
-  lock.from = drawn_toe;
-  lock.offset = drawn_toe - anim_toe;
-  lock.offset_vel = drawn_vel - anim_vel;
-
-  lock.shed = lock.shed_from = lock.shed_goal = lock.released_s = lock.release_time_s = 0.0f;
-  lock.swing_from = -1.0f;  // taken from the first frame's progress
+// A pinned toe follows the clip's toe down onto the floor as the foot rolls from the heel onto
+// the ball, and never up again while the ball bears weight (the heel rises about it).
+FootLock lower_pin(const FootLock& s, const FootLockInput& in) {
+  FootLock out = s;
+  out.target.y = std::min(out.target.y, std::max(in.floor_toe_m, in.anim_toe.y));
+  return out;
 }
 
-void start_foot_step(FootLock& lock, const glm::vec3& from) {
-  lock.state = FootLockState::kStepping;
-  lock.from = from;
-  lock.timer_s = 0.0f;
-  lock.offset = lock.offset_vel = glm::vec3(0.0f);
+// The offset of a foot that is not being released decays toward zero (Holden's decay spring:
+// exact for any dt).
+FootLock decay_offset(const FootLock& s, const FootLockParams& p, float dt) {
+  FootLock out = s;
+  critical_spring(out.offset, out.offset_vel, glm::vec3(0.0f), p.release_halflife_s, dt);
+  return out;
 }
 
-namespace {
-
-glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams& p, float dt) {
-  const glm::vec3 anim_vel = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
-  // The clip's toe speed over the ground, this frame and last (< 0: none yet).
-  const float speed = std::hypot(anim_vel.x, anim_vel.z);
-  const float last_speed = lock.anim_speed;
-  lock.anim_speed = in.fresh ? -1.0f : speed;
-  auto lock_here = [&](const glm::vec3& at) {
-    lock.state = FootLockState::kLocked;
-    // Pinned no higher than it is drawn (a pinned toe never rises) nor than the clip has it, and
-    // never below the floor; a foot drawn above that settles down onto it.
-    const float drawn_y = in.fresh ? in.anim_toe.y : in.drawn_toe_prev.y;
-    const float y = std::max(in.floor_toe_m, std::min(drawn_y, in.anim_toe.y));
-    lock.target = glm::vec3(at.x, y, at.z);
-    lock.offset = glm::vec3(0.0f, std::max(0.0f, drawn_y - y), 0.0f);
-    lock.offset_vel = glm::vec3(0.0f);
-  };
-  // Where the toe is drawn while pinned: it follows the clip's toe down onto the floor as the foot
-  // rolls from the heel onto the ball, and never up again while the ball bears weight (the heel
-  // rises about it); the clips lifting it ends the lock.
-  auto pinned_goal = [&] {
-    lock.target.y = std::min(lock.target.y, std::max(in.floor_toe_m, in.anim_toe.y));
-    return lock.target;
-  };
-
-  switch (lock.state) {
+// This frame's transition from the state the foot was in. speed and last_speed are the clip's toe
+// speed over the ground this frame and last (< 0: none).
+FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockParams& p,
+                    const glm::vec3& anim_vel, float speed, float last_speed) {
+  switch (s.state) {
     case FootLockState::kFree:
     case FootLockState::kReleasing: {
       // The clips plant the foot while its ball may still roll down and forward off the heel
       // (and a blend of clips lands a foot over a few frames): it is pinned once the ball has come
       // to rest over the ground, or has stopped slowing down, where it was drawn last frame.
-      const bool at_rest = in.fresh || speed <= in.still_speed_m_s ||
-                           (last_speed >= 0.0f && speed >= last_speed);
-      if (in.plant && at_rest) lock_here(in.fresh ? in.anim_toe : in.drawn_toe_prev);
-      break;
+      const bool at_rest =
+          in.fresh || speed <= in.still_speed_m_s || (last_speed >= 0.0f && speed >= last_speed);
+      return in.plant && at_rest ? plant_foot(s, in) : s;
     }
     case FootLockState::kLocked: {
+      const FootLock pinned = lower_pin(s, in);
       if (!in.hold && !in.other_landing) {
-        release_foot_lock(lock, pinned_goal() + lock.offset, glm::vec3(0.0f), in.anim_toe,
-                          anim_vel);
-        break;
+        return release_foot_lock(pinned, pinned.target + pinned.offset, glm::vec3(0.0f),
+                                 in.anim_toe, anim_vel);
       }
       // A foot left behind by a turn or a drift re-plants with a short step, one foot at a time.
-      const float drift = std::hypot(lock.target.x - in.anim_toe.x, lock.target.z - in.anim_toe.z);
-      if (drift > p.step_distance_m && in.other_locked)
-        start_foot_step(lock, pinned_goal() + lock.offset);
-      break;
+      const float drift = std::hypot(s.target.x - in.anim_toe.x, s.target.z - in.anim_toe.z);
+      if (drift > p.step_distance_m && in.other_locked) {
+        return start_foot_step(pinned, pinned.target + pinned.offset);
+      }
+      return s;
     }
     case FootLockState::kStepping:
       // The clips lift the foot before the step is done: it joins their swing from where it is,
       // at the speed it has.
-      if (!in.hold) release_foot_lock(lock, lock.last_goal, lock.goal_vel, in.anim_toe, anim_vel);
-      break;
+      return in.hold ? s : release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe, anim_vel);
   }
+  return s;
+}
 
-  if (lock.state != FootLockState::kReleasing) {
-    decay_offset(lock.offset, lock.offset_vel, p.release_halflife_s, dt);
-  }
-  switch (lock.state) {
-    case FootLockState::kFree:
-      return in.anim_toe + lock.offset;
-    case FootLockState::kReleasing: {
-      // Shed in the swing's progress from where the release began (a progress that went back,
-      // as when the blend changes clips, restarts the count from there: never a jump).
-      if (lock.swing_from < 0.0f) {
-        // Smoothstep's speed peaks at 1.5 times its mean: at the clips' swing speed at most.
-        const float across = std::hypot(lock.offset.x, lock.offset.z);
-        lock.release_time_s = 2.0f * p.release_halflife_s;
-        if (p.swing_speed_m_s > 0.0f) {
-          lock.release_time_s = std::max(lock.release_time_s, 1.5f * across / p.swing_speed_m_s);
-        }
-      }
-      if (lock.swing_from < 0.0f || in.swing_progress + 0.05f < lock.swing_from) {
-        lock.swing_from = std::min(in.swing_progress, 0.9f);
-        lock.shed_from = lock.shed_goal;
-      }
-      const float u = (in.swing_progress - lock.swing_from) / (1.0f - lock.swing_from);
-      lock.shed_goal =
-          std::max(lock.shed_goal, lock.shed_from + (1.0f - lock.shed_from) * smoothstep01(u));
-      // A release late in the swing still takes its time (twice the halflife at least), not a
-      // frame or two; it may then land before the offset is gone, and is pinned where it is.
-      lock.released_s += dt;
-      const float by_time = smoothstep01(lock.released_s / lock.release_time_s);
-      lock.shed = std::max(lock.shed, std::min(lock.shed_goal, by_time));
-      // Upward the foot follows the clip's lift at once (a spring, so the knee does not snap);
-      // sideways it is corrected over the swing.
-      {
-        float y = lock.offset.y, vy = lock.offset_vel.y;
-        critical_spring(y, vy, 0.0f, 0.5f * p.release_halflife_s, dt);
-        lock.offset.y = y;
-        lock.offset_vel.y = vy;
-      }
-      glm::vec3 goal = in.anim_toe + lock.offset * (1.0f - lock.shed);
-      goal.y = in.anim_toe.y + lock.offset.y;
-      if (lock.shed >= 1.0f) {
-        lock.state = FootLockState::kFree;
-        lock.offset = lock.offset_vel = glm::vec3(0.0f);
-      }
-      return goal;
-    }
-    case FootLockState::kLocked:
-      return pinned_goal() + lock.offset;
-    case FootLockState::kStepping: {
-      // Lifted, carried and set down where the clip has the foot, as high as the clips' own
-      // swing: the foot rises before it moves and stops moving before it lands (zero speed at
-      // both ends, so nothing snaps).
-      lock.timer_s += dt;
-      const float u = std::min(1.0f, lock.timer_s / p.step_time_s);
-      const float s = std::sin(std::numbers::pi_v<float> * u);
-      glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
-      // Where it lands is chosen before it comes down: it follows the clip's foot while it is
-      // carried, and is set down on the spot it was carried to (a body turning on the spot would
-      // otherwise drag the landing foot along the ground).
-      if (u < 1.0f - kStepLift) {
-        lock.step_to = to;
-      } else {
-        to.x = lock.step_to.x;
-        to.z = lock.step_to.z;
-      }
-      glm::vec3 goal =
-          glm::mix(lock.from, to, smoothstep01((u - kStepLift) / (1.0f - 2.0f * kStepLift)));
-      goal.y = glm::mix(lock.from.y, to.y, smoothstep01(u)) + p.step_height_m * s * s;
-      if (u >= 1.0f) {
-        lock.state = FootLockState::kLocked;
-        lock.target = to;
-      }
-      return goal;
+// A free foot is drawn at the clip's toe plus what is left of a landing offset.
+FootLockStep free_foot(const FootLock& s, const FootLockInput& in) {
+  return {s, in.anim_toe + s.offset};
+}
+
+// A pinned foot is drawn at its pin (lowered onto the clip's toe) plus the settling offset.
+FootLockStep pinned_foot(const FootLock& s, const FootLockInput& in) {
+  const FootLock out = lower_pin(s, in);
+  return {out, out.target + out.offset};
+}
+
+// A released foot sheds its offset in the swing's progress from where the release began, and
+// never in less than twice the halflife; done, it is free.
+FootLockStep releasing_foot(const FootLock& s, const FootLockInput& in, const FootLockParams& p,
+                            float dt) {
+  FootLock out = s;
+  if (out.swing_from < 0.0f) {
+    // The release's shortest time: twice the halflife, and long enough that the foot is never
+    // carried faster than the clips' own swing (smoothstep's speed peaks at 1.5 times its mean).
+    const float across = std::hypot(out.offset.x, out.offset.z);
+    out.release_time_s = 2.0f * p.release_halflife_s;
+    if (p.swing_speed_m_s > 0.0f) {
+      out.release_time_s = std::max(out.release_time_s, 1.5f * across / p.swing_speed_m_s);
     }
   }
-  return in.anim_toe;
+  // A progress that went back, as when the blend changes clips, restarts the count from there:
+  // never a jump.
+  if (out.swing_from < 0.0f || in.swing_progress + 0.05f < out.swing_from) {
+    out.swing_from = std::min(in.swing_progress, 0.9f);
+    out.shed_from = out.shed_goal;
+  }
+  const float u = (in.swing_progress - out.swing_from) / (1.0f - out.swing_from);
+  out.shed_goal = std::max(out.shed_goal, out.shed_from + (1.0f - out.shed_from) * smoothstep01(u));
+  // A release late in the swing still takes its time (twice the halflife at least), not a frame
+  // or two; it may then land before the offset is gone, and is pinned where it is.
+  out.released_s += dt;
+  const float by_time = smoothstep01(out.released_s / out.release_time_s);
+  out.shed = std::max(out.shed, std::min(out.shed_goal, by_time));
+  // Upward the foot follows the clip's lift at once (a spring, so the knee does not snap);
+  // sideways it is corrected over the swing.
+  {
+    float y = out.offset.y, vy = out.offset_vel.y;
+    critical_spring(y, vy, 0.0f, 0.5f * p.release_halflife_s, dt);
+    out.offset.y = y;
+    out.offset_vel.y = vy;
+  }
+  glm::vec3 goal = in.anim_toe + out.offset * (1.0f - out.shed);
+  goal.y = in.anim_toe.y + out.offset.y;
+  if (out.shed >= 1.0f) {
+    out.state = FootLockState::kFree;
+    out.offset = out.offset_vel = glm::vec3(0.0f);
+  }
+  return {out, goal};
+}
+
+// A re-planting step: lifted, carried and set down where the clip has the foot, as high as the
+// clips' own swing: the foot rises before it moves and stops moving before it lands (zero speed at
+// both ends, so nothing snaps). Landed, it is pinned there.
+FootLockStep stepping_foot(const FootLock& s, const FootLockInput& in, const FootLockParams& p,
+                           float dt) {
+  FootLock out = s;
+  out.timer_s += dt;
+  const float u = std::min(1.0f, out.timer_s / p.step_time_s);
+  const float sn = std::sin(std::numbers::pi_v<float> * u);
+  glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
+  // Where it lands is chosen before it comes down: it follows the clip's foot while it is
+  // carried, and is set down on the spot it was carried to (a body turning on the spot would
+  // otherwise drag the landing foot along the ground).
+  if (u < 1.0f - kStepLift) {
+    out.step_to = to;
+  } else {
+    to.x = out.step_to.x;
+    to.z = out.step_to.z;
+  }
+  glm::vec3 goal =
+      glm::mix(out.from, to, smoothstep01((u - kStepLift) / (1.0f - 2.0f * kStepLift)));
+  goal.y = glm::mix(out.from.y, to.y, smoothstep01(u)) + p.step_height_m * sn * sn;
+  if (u >= 1.0f) {
+    out.state = FootLockState::kLocked;
+    out.target = to;
+  }
+  return {out, goal};
 }
 
 }  // namespace
 
-glm::vec3 step_foot_lock(FootLock& lock, const FootLockInput& in, const FootLockParams& p,
-                         float dt) {
-  if (in.fresh) {
-    lock = FootLock();
-    lock.last_goal = in.anim_toe;
+FootLock fresh_foot_lock(const glm::vec3& anim_toe) {
+  FootLock s;
+  s.last_goal = anim_toe;
+  return s;
+}
+
+FootLock plant_foot(const FootLock& s, const FootLockInput& in) {
+  // Pinned no higher than it is drawn (a pinned toe never rises) nor than the clip has it, and
+  // never below the floor; a foot drawn above that settles down onto it.
+  const glm::vec3 at = in.fresh ? in.anim_toe : in.drawn_toe_prev;
+  const float drawn_y = at.y;
+  const float y = std::max(in.floor_toe_m, std::min(drawn_y, in.anim_toe.y));
+  FootLock out = s;
+  out.state = FootLockState::kLocked;
+  out.target = glm::vec3(at.x, y, at.z);
+  out.offset = glm::vec3(0.0f, std::max(0.0f, drawn_y - y), 0.0f);
+  out.offset_vel = glm::vec3(0.0f);
+  return out;
+}
+
+FootLock start_foot_step(const FootLock& s, const glm::vec3& from) {
+  FootLock out = s;
+  out.state = FootLockState::kStepping;
+  out.from = usable(from) ? from : s.last_goal;
+  out.timer_s = 0.0f;
+  out.offset = out.offset_vel = glm::vec3(0.0f);
+  return out;
+}
+
+FootLock release_foot_lock(const FootLock& s, const glm::vec3& drawn_toe,
+                           const glm::vec3& drawn_vel, const glm::vec3& anim_toe,
+                           const glm::vec3& anim_vel) {
+  const glm::vec3 drawn = usable(drawn_toe) ? drawn_toe : s.last_goal;
+  const glm::vec3 anim = usable(anim_toe) ? anim_toe : drawn;
+  const glm::vec3 dv = usable(drawn_vel) ? drawn_vel : glm::vec3(0.0f);
+  const glm::vec3 av = usable(anim_vel) ? anim_vel : glm::vec3(0.0f);
+  FootLock out = s;
+  out.state = FootLockState::kReleasing;
+  out.from = drawn;
+  out.offset = drawn - anim;
+  out.offset_vel = dv - av;
+  out.shed = out.shed_from = out.shed_goal = out.released_s = out.release_time_s = 0.0f;
+  out.swing_from = -1.0f;  // taken from the first frame's progress
+  return out;
+}
+
+FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& raw,
+                            const FootLockParams& p, float dt) {
+  // Nothing to follow or no time step: the foot stays as it is (a fresh one at the origin).
+  if (!usable(raw.anim_toe) || !(dt > 0.0f) || !std::isfinite(dt)) {
+    const FootLock s = raw.fresh ? FootLock() : state;
+    return {s, s.last_goal};
   }
-  const glm::vec3 goal = advance(lock, in, p, dt);
-  lock.goal_vel = in.fresh ? glm::vec3(0.0f) : (goal - lock.last_goal) / dt;
-  lock.last_goal = goal;
-  return goal;
+  const FootLockInput in = sanitised(raw);
+  FootLock s = in.fresh ? fresh_foot_lock(in.anim_toe) : state;
+  const glm::vec3 anim_vel = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
+  // The clip's toe speed over the ground, this frame and last (< 0: none yet).
+  const float speed = std::hypot(anim_vel.x, anim_vel.z);
+  const float last_speed = s.anim_speed;
+  s.anim_speed = in.fresh ? -1.0f : speed;
+
+  s = transition(s, in, p, anim_vel, speed, last_speed);
+  if (s.state != FootLockState::kReleasing) s = decay_offset(s, p, dt);
+  FootLockStep next{s, in.anim_toe};
+  switch (s.state) {
+    case FootLockState::kFree:
+      next = free_foot(s, in);
+      break;
+    case FootLockState::kLocked:
+      next = pinned_foot(s, in);
+      break;
+    case FootLockState::kReleasing:
+      next = releasing_foot(s, in, p, dt);
+      break;
+    case FootLockState::kStepping:
+      next = stepping_foot(s, in, p, dt);
+      break;
+  }
+  next.state.goal_vel = in.fresh ? glm::vec3(0.0f) : (next.goal - next.state.last_goal) / dt;
+  next.state.last_goal = next.goal;
+  return next;
 }
 
 }  // namespace gk

@@ -1,15 +1,25 @@
 #pragma once
-// The foot-lock state machine of one foot as a small pure function (state in, state and toe goal
-// out), so it can be tested alone. Pose synthesis runs it per foot and turns the goal into leg IK.
+// The foot-lock state machine of one foot as small pure functions (Holden's style: explicit state
+// in, state out; the caller stores it), so each transition can be tested alone. Pose synthesis runs
+// step_foot_lock per foot and turns the goal into leg IK.
 //
-// A foot the clips put on the ground is pinned where it was drawn; it is held until the clips lift
-// it, then released: the difference between where it was drawn and where the clip has it becomes
-// an offset that the foot sheds over the clips' own swing (smoothly in the swing's progress, gone
-// when the clip lands the foot), so no joint snaps, the correction happens in the air, and the
-// swing keeps the clip's own height. A foot that lands settles onto the floor through a decaying
-// offset (a critically damped spring, exact for any step). A pinned foot left far behind by a turn
-// or a drift re-plants, while the other foot is pinned, with a short step as high as the clips'
-// own swing.
+// A foot the clips put on the ground is pinned where it was drawn (plant_foot); it is held until
+// the clips lift it, then released (release_foot_lock): the difference between where it was drawn
+// and where the clip has it becomes an offset that the foot sheds over the clips' own swing
+// (smoothly in the swing's progress, gone when the clip lands the foot), so no joint snaps, the
+// correction happens in the air, and the swing keeps the clip's own height. A foot that lands
+// settles onto the floor through a decaying offset (a critically damped spring, exact for any
+// step). A pinned foot left far behind by a turn or a drift re-plants (start_foot_step), while the
+// other foot is pinned, with a short step as high as the clips' own swing.
+//
+//   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest
+//   kReleasing -> kLocked     plant_foot: planted again before the offset was shed
+//   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing)
+//   kLocked    -> kStepping   start_foot_step: left too far behind while the other foot is pinned
+//   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done
+//   kStepping  -> kLocked     the step has landed: pinned at the clip's toe
+//   kReleasing -> kFree       the offset is shed
+//   any        -> kFree       fresh_foot_lock: an agent's first frame
 
 #include <cstdint>
 
@@ -53,7 +63,7 @@ struct FootLockInput {
   // weight (its lock) until the other has taken it over, as a trailing foot stays down until the
   // leading one is flat. (Running has a flight phase: no such wait.)
   bool other_landing = false;
-  float floor_toe_m = 0.0f;        // where planted toes are (library floor) [m]
+  float floor_toe_m = 0.0f;  // where planted toes are (library floor) [m]
   // A ball this slow over the ground is at rest (clip analysis's "still": half the travel speed,
   // at least its capture-jitter floor) [m/s]. A plant pins the foot once its ball is at rest, or
   // once it has stopped slowing down: at its slowest, so the drawn foot stops with no jolt.
@@ -61,27 +71,50 @@ struct FootLockInput {
 };
 
 struct FootLockParams {
-  float release_halflife_s = 0.06f;  // [s] halflife of the released foot's offset
-  float step_distance_m = 0.25f;     // [m] a pinned foot this far from the clip's re-plants
-  float step_time_s = 0.35f;         // [s] duration of a re-planting step
-  float step_height_m = 0.05f;       // [m] its height (the clips' own swing)
+  // [s] halflife of a landing foot's offset; a release sheds its offset in no less than twice it
+  float release_halflife_s = 0.06f;
+  float step_distance_m = 0.25f;  // [m] a pinned foot this far from the clip's re-plants
+  float step_time_s = 0.35f;      // [s] duration of a re-planting step
+  float step_height_m = 0.05f;    // [m] its height (the clips' own swing)
   // [m/s] the clips' own peak swing speed: a released foot is never carried faster than this
   // toward the clip's foot (a long offset takes longer to shed; <= 0: no limit).
   float swing_speed_m_s = 0.0f;
 };
 
-// Advances one foot by dt_s and returns where its toe should be drawn (world, before any pelvis
-// drop and floor clamp; the caller applies both).
-glm::vec3 step_foot_lock(FootLock& lock, const FootLockInput& in, const FootLockParams& p,
-                         float dt_s);
+// One frame of one foot: its next state and where its toe should be drawn (world, before any
+// pelvis drop and floor clamp; the caller applies both).
+struct FootLockStep {
+  FootLock state;
+  glm::vec3 goal{0.0f};
+};
+
+// Advances one foot by dt_s [s]: the state's transition for this input (plant, release, step), then
+// where the foot is drawn in its new state. Unusable input (NaN, infinities, coordinates beyond
+// 1e6 m, a dt_s that is not a finite positive number) never reaches the state: without a usable
+// clip toe or time step the foot keeps its state and its last goal (a fresh one is a default
+// FootLock drawn at the origin); an unusable previous toe counts as the clip's toe this frame, an
+// unusable floor as none, an unusable swing progress or still speed as 0.
+FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& in,
+                            const FootLockParams& params, float dt_s);
+
+// A new agent's foot: unlocked, drawn at the clip's toe (no offset, no speed).
+FootLock fresh_foot_lock(const glm::vec3& anim_toe);
+
+// Pins the foot where it was drawn last frame (the clip's toe on a fresh frame), no higher than
+// drawn nor than the clip has it and never below the floor; a foot drawn above that settles onto
+// it through the offset. Expects usable input (step_foot_lock replaces what is not).
+FootLock plant_foot(const FootLock& state, const FootLockInput& in);
 
 // Starts a re-planting step of a pinned foot from where it is drawn (from): used when the leg
-// cannot reach where it is pinned while the clips still have the foot on the ground.
-void start_foot_step(FootLock& lock, const glm::vec3& from);
+// cannot reach where it is pinned while the clips still have the foot on the ground. An unusable
+// `from` starts from the last goal.
+FootLock start_foot_step(const FootLock& state, const glm::vec3& from);
 
 // Lets a pinned or stepping foot go from where it is drawn (drawn_toe, moving at drawn_vel) to the
-// clip's toe (anim_toe, moving at anim_vel) through an inertialization offset.
-void release_foot_lock(FootLock& lock, const glm::vec3& drawn_toe, const glm::vec3& drawn_vel,
-                       const glm::vec3& anim_toe, const glm::vec3& anim_vel);
+// clip's toe (anim_toe, moving at anim_vel) through an inertialization offset. Unusable values
+// count as: the last goal for drawn_toe, drawn_toe for anim_toe, no speed for the velocities.
+FootLock release_foot_lock(const FootLock& state, const glm::vec3& drawn_toe,
+                           const glm::vec3& drawn_vel, const glm::vec3& anim_toe,
+                           const glm::vec3& anim_vel);
 
 }  // namespace gk

@@ -5,7 +5,9 @@
 // foot locking, runs in the pose synthesis pass where the animated feet are known).
 //
 // All per-agent data lives in slots (structure of arrays) sized for the crowd's capacity at
-// construction; plan() allocates nothing and runs over agents in parallel.
+// construction; plan() allocates nothing. It validates the frame, assigns slots, then runs the
+// whole-crowd passes of mediator/mediator_passes.h in order (filter, root, facing, weights, rate
+// and phase, contacts, feedback), each over every agent in parallel.
 
 #include <cstdint>
 #include <span>
@@ -61,12 +63,12 @@ class Mediator {
   std::span<const glm::vec2> sim_velocities() const { return {sim_vel_.data(), num_agents_}; }
 
  private:
-  // The checks of plan(); writes only scratch (seen_, found_slot_, new_ids_, emptied again).
+  // validate: the checks of plan(); writes only scratch (seen_, found_slot_, new_ids_, emptied
+  // again).
   Status validate(const AgentFrame& frame, float dt_s);
+  // slots: known agents keep their slots, vanished ones free theirs, newcomers are initialised.
+  void assign_slots(const AgentFrame& frame);
   void init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta);
-  void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
-                  float dt, bool feedback);
-  void choose_weights(int slot, float speed, float rel_dir, float* out_w) const;
 
   const LocomotionLibrary& library_;
   MediatorParams params_;
@@ -78,20 +80,22 @@ class Mediator {
   std::vector<uint8_t> seen_;
   std::vector<int32_t> found_slot_;  // scratch of validate(): agent -> known slot, or -1
   IdSlotMap new_ids_;                // scratch of validate(): the frame's newcomers
-  AnimationPlans plans_;
+  AnimationPlans plans_;             // also carries the gait phase from frame to frame
   FeedbackBuffers feedback_;
-  std::vector<glm::vec2> sim_vel_;
-  // Per-slot state.
+  // Per agent: the frame as sanitised by the filter pass.
+  std::vector<glm::vec2> sim_pos_, sim_vel_;
+  std::vector<float> sim_theta_;
+  // Per slot, carried from frame to frame.
   std::vector<glm::vec2> vel_, vel_rate_;  // velocity spring
   std::vector<float> theta_, theta_rate_;  // theta spring (unwrapped)
-  std::vector<float> lower_target_;        // discrete target facing of the lower body
+  std::vector<float> lower_target_;        // target facing of the lower body
   std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
-  std::vector<float> phase_;               // gait phase
   std::vector<float> idle_time_;           // clock of the standing clip
   std::vector<float> cadence_scale_;       // per-agent variety
-  std::vector<float> fade_;                // blend progress
-  std::vector<int16_t> dominant_;          // clip with the largest target weight
-  std::vector<float> scratch_target_;      // [slot * num_clips]
+  // Per slot, scratch between passes.
+  std::vector<float> root_heading_;    // root pass -> facing pass
+  std::vector<float> rel_dir_;         // facing pass -> weights pass
+  std::vector<float> scratch_target_;  // [slot * num_clips]: the weights pass's target weights
 };
 
 }  // namespace gk

@@ -296,7 +296,9 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     in.still_speed_m_s =
         std::max(ContactThresholds{}.min_still_speed_m_s,
                  ContactThresholds{}.still_fraction_of_travel * pl.speed_m_s[slot]);
-    goal[side] = step_foot_lock(locks_.lock[k], in, lp, dt);
+    const FootLockStep next = step_foot_lock(locks_.lock[k], in, lp, dt);
+    locks_.lock[k] = next.state;
+    goal[side] = next.goal;
     anim_vel[side] = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
 
     locks_.anim_toe[k] = anim_toe[side];
@@ -400,12 +402,13 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
       const bool other_locked =
           locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
-        if (pl.plant[side][slot] >= 0.5f && other_locked) {
-        start_foot_step(locks_.lock[k], drawn);
+      if (pl.plant[side][slot] >= 0.5f && other_locked) {
+        locks_.lock[k] = start_foot_step(locks_.lock[k], drawn);
       } else {
         // Both in the space of the lock's goals (the body before its drop): the offset is what
         // really separates the drawn toe from the clip's, not the drop as well.
-        release_foot_lock(locks_.lock[k], drawn, glm::vec3(0.0f), anim_toe[side], anim_vel[side]);
+        locks_.lock[k] = release_foot_lock(locks_.lock[k], drawn, glm::vec3(0.0f), anim_toe[side],
+                                           anim_vel[side]);
       }
     }
     const glm::vec3 knee_p = translation_of(world_[base + knee]);

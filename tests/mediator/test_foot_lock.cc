@@ -41,7 +41,9 @@ struct Foot {
     in.still_speed_m_s = still_speed;
     started = true;
     anim = anim_toe;
-    goal = step_foot_lock(lock, in, params, kDt);
+    const FootLockStep next = step_foot_lock(lock, in, params, kDt);
+    lock = next.state;
+    goal = next.goal;
     return goal;
   }
 };
@@ -124,7 +126,7 @@ TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
   in.fresh = true;
   in.plant = in.hold = true;
   in.floor_toe_m = kFloor;
-  step_foot_lock(lock, in, params, kDt);
+  lock = step_foot_lock(lock, in, params, kDt).state;
   ASSERT_EQ(lock.state, FootLockState::kLocked);
   in.fresh = false;
   in.plant = in.hold = false;  // the clip lifts the foot
@@ -132,7 +134,9 @@ TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
   for (int f = 0; f < 3; ++f) {
     in.anim_toe_prev = in.anim_toe;
     in.anim_toe += glm::vec3(0.01f, 0.005f, 0.0f);
-    const glm::vec3 goal = step_foot_lock(lock, in, params, kDt);
+    const FootLockStep next = step_foot_lock(lock, in, params, kDt);
+    lock = next.state;
+    const glm::vec3 goal = next.goal;
     EXPECT_EQ(lock.state, FootLockState::kLocked);
     EXPECT_FLOAT_EQ(goal.x, 0.0f);
     EXPECT_FLOAT_EQ(goal.y, kFloor);
@@ -140,7 +144,7 @@ TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
   in.other_landing = false;  // the other foot is pinned: this one goes
   in.anim_toe_prev = in.anim_toe;
   in.anim_toe += glm::vec3(0.01f, 0.005f, 0.0f);
-  step_foot_lock(lock, in, params, kDt);
+  lock = step_foot_lock(lock, in, params, kDt).state;
   EXPECT_EQ(lock.state, FootLockState::kReleasing);
 }
 
@@ -236,7 +240,7 @@ TEST(FootLock, ReplantingStepLiftsFirstAndLandsOnTheClipsToe) {
   Foot foot;
   const glm::vec3 from(0.0f, kFloor, 0.0f), to(0.3f, kFloor, 0.1f);
   foot.step(from, true, true);
-  start_foot_step(foot.lock, foot.goal);
+  foot.lock = start_foot_step(foot.lock, foot.goal);
   ASSERT_EQ(foot.lock.state, FootLockState::kStepping);
   const float h = foot.params.step_height_m, T = foot.params.step_time_s;
   float peak = -1.0f;
@@ -284,7 +288,7 @@ TEST(FootLock, StepBecomesAReleaseWhenTheClipsLiftTheFoot) {
   Foot foot;
   const glm::vec3 to(0.3f, kFloor, 0.0f);
   foot.step(glm::vec3(0.0f, kFloor, 0.0f), true, true);
-  start_foot_step(foot.lock, foot.goal);
+  foot.lock = start_foot_step(foot.lock, foot.goal);
   glm::vec3 before = foot.goal;
   for (int k = 1; k <= 8; ++k) {
     before = foot.goal;
@@ -346,9 +350,13 @@ TEST(FootLock, GoalIsNeverNaN) {
       in.swing_progress = -0.5f + 2.0f * unit(rng);
       in.other_locked = unit(rng) < 0.5f;
       in.floor_toe_m = 0.2f * (unit(rng) - 0.5f);
-      if (unit(rng) < 0.03f) start_foot_step(lock, goal);
-      if (unit(rng) < 0.03f) release_foot_lock(lock, goal, glm::vec3(pos(rng)), anim, glm::vec3(0));
-      goal = step_foot_lock(lock, in, params, dt);
+      if (unit(rng) < 0.03f) lock = start_foot_step(lock, goal);
+      if (unit(rng) < 0.03f) {
+        lock = release_foot_lock(lock, goal, glm::vec3(pos(rng)), anim, glm::vec3(0));
+      }
+      const FootLockStep next = step_foot_lock(lock, in, params, dt);
+      lock = next.state;
+      goal = next.goal;
       ASSERT_TRUE(std::isfinite(goal.x) && std::isfinite(goal.y) && std::isfinite(goal.z))
           << "run " << run << " frame " << f;
     }

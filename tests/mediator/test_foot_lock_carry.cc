@@ -19,6 +19,13 @@ float horizontal(const glm::vec3& a, const glm::vec3& b) {
   return std::hypot(a.x - b.x, a.z - b.z);
 }
 
+// One frame of the pure state machine: the lock advances in place, the goal is returned.
+glm::vec3 advance(FootLock& lock, const FootLockInput& in, const FootLockParams& p) {
+  const FootLockStep r = step_foot_lock(lock, in, p, kDt);
+  lock = r.state;
+  return r.goal;
+}
+
 FootLockInput input(const glm::vec3& anim, const glm::vec3& anim_prev, const glm::vec3& drawn_prev,
                     bool plant, bool hold, float progress) {
   FootLockInput in;
@@ -40,16 +47,16 @@ TEST(FootLockCarry, StepSetsTheFootDownWhereItWasCarried) {
   glm::vec3 anim(0.0f, kFloor, 0.0f);
   FootLockInput in = input(anim, anim, anim, true, true, 0.0f);
   in.fresh = true;
-  glm::vec3 goal = step_foot_lock(lock, in, p, kDt);
+  glm::vec3 goal = advance(lock, in, p);
   ASSERT_EQ(lock.state, FootLockState::kLocked);
-  start_foot_step(lock, goal);
+  lock = start_foot_step(lock, goal);
   const float speed = 1.5f;  // [m/s] of the clip's toe
   int lowering = 0;
   glm::vec3 set_down(0.0f);
   for (int k = 1; k <= 40 && lock.state == FootLockState::kStepping; ++k) {
     const glm::vec3 prev_anim = anim, prev_goal = goal;
     anim.x += speed * kDt;
-    goal = step_foot_lock(lock, input(anim, prev_anim, prev_goal, false, true, 0.0f), p, kDt);
+    goal = advance(lock, input(anim, prev_anim, prev_goal, false, true, 0.0f), p);
     const float t = k * kDt;
     if (t >= (1.0f - 0.2f) * p.step_time_s + kDt) {
       // The last fifth only sets the foot down: no horizontal motion at all.
@@ -65,7 +72,7 @@ TEST(FootLockCarry, StepSetsTheFootDownWhereItWasCarried) {
   const glm::vec3 prev_anim = anim;
   anim.x += speed * kDt;
   const glm::vec3 pinned =
-      step_foot_lock(lock, input(anim, prev_anim, goal, false, true, 0.0f), p, kDt);
+      advance(lock, input(anim, prev_anim, goal, false, true, 0.0f), p);
   EXPECT_NEAR(horizontal(pinned, goal), 0.0f, 1e-6f);
 }
 
@@ -80,15 +87,14 @@ TEST(FootLockCarry, ReleasedFootIsCarriedNoFasterThanTheClipsSwing) {
     const glm::vec3 pinned(0.0f, kFloor, 0.0f), anim(0.75f, kFloor, 0.0f);
     FootLockInput in = input(pinned, pinned, pinned, true, true, 0.0f);
     in.fresh = true;
-    glm::vec3 goal = step_foot_lock(lock, in, p, kDt);
-    release_foot_lock(lock, goal, glm::vec3(0.0f), anim, glm::vec3(0.0f));
+    glm::vec3 goal = advance(lock, in, p);
+    lock = release_foot_lock(lock, goal, glm::vec3(0.0f), anim, glm::vec3(0.0f));
     float fastest = 0.0f;
     int frames = 0;
     for (int k = 1; k <= 120 && lock.state == FootLockState::kReleasing; ++k, ++frames) {
       const glm::vec3 prev = goal;
       // A short swing of the clips (0.1 s, as at a crawl in a jam); their toe stays put.
-      goal = step_foot_lock(lock, input(anim, anim, prev, false, false, std::min(1.0f, k / 6.0f)),
-                            p, kDt);
+      goal = advance(lock, input(anim, anim, prev, false, false, std::min(1.0f, k / 6.0f)), p);
       fastest = std::max(fastest, horizontal(goal, prev) / kDt);
     }
     EXPECT_NEAR(horizontal(goal, anim), 0.0f, 1e-4f);

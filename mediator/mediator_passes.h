@@ -1,0 +1,164 @@
+#pragma once
+// The mediator's frame as named whole-crowd passes, run in this order by Mediator::plan() (in the
+// manner of DetourCrowd's dtCrowd::update: one phase over the whole crowd after the other):
+//
+//   filter    the simulator's p, v, theta sanitised and smoothed   (per agent -> per slot)
+//   root      the drawn root pulled onto p, and its heading
+//   facing    lower-body yaw (psi), upper-body yaw, travel direction relative to psi
+//   weights   target clip weights, faded, cut to the heaviest kMaxBlendLayers layers
+//   rate      playback rate and gait phase
+//   contacts  clip times, plant / hold / swing progress of each foot, the gait clips' toe height
+//   feedback  what the animation can deliver, for the simulator     (per slot -> per agent)
+//
+// Each pass reads and writes flat arrays only (spans: const what it reads, mutable what it writes;
+// per slot unless it says per agent) and runs over every agent of the frame in parallel; an agent's
+// work in a pass never touches another agent's data, so the passes' results do not depend on the
+// order or the threads. Nothing here allocates.
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+
+#include "crowd/crowd_source.h"
+#include "mediator/locomotion_library.h"
+#include "mediator/params.h"
+
+namespace gk {
+
+// What every pass sees: the library, the parameters, the step, and the agents to run over. Every
+// pass visits the frame's agent i in slot slot_of_agent[i], for i < slot_of_agent.size(), through
+// one loop (for_each_agent in mediator_passes.cc): a level of detail that plans only the agents
+// due this frame would skip the others there, in one place.
+struct PassCrowd {
+  const LocomotionLibrary& library;
+  const MediatorParams& params;
+  float dt_s;                              // [s] (0, 1]
+  std::span<const int32_t> slot_of_agent;  // per agent: its slot
+  std::span<const uint8_t> fresh;          // per slot: 1 on the agent's first frame
+};
+
+// The simulator's values are garbage beyond these (NaN, 1e30, a velocity no body has).
+inline constexpr float kAbsurdSpeed = 15.0f;   // [m/s]
+inline constexpr float kMaxCoordinate = 1e6f;  // [m] from the origin: a float cannot hold a step
+inline bool finite2(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+inline bool usable_position(const glm::vec2& p) {
+  return finite2(p) && std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate;
+}
+// True when the simulator gave this agent nothing to sanitise.
+inline bool sane_input(const glm::vec2& p, const glm::vec2& v, float theta) {
+  return finite2(v) && !(glm::length(v) > kAbsurdSpeed) && usable_position(p) &&
+         std::isfinite(theta);
+}
+// Ground heading of a direction (x, z) [rad]: 0 along +z.
+inline float heading2(const glm::vec2& v) { return std::atan2(v.x, v.y); }
+
+// Target clip weights (library.clips.size() of them, summing to 1) for a filtered speed [m/s] and
+// a travel direction relative to the lower body [rad]: standing below the stop speed; the
+// nearest-speed forward clip outside APM; else the (direction, speed) blend space.
+void choose_clip_weights(const LocomotionLibrary& library, const MediatorParams& params,
+                         float speed, float rel_dir, std::span<float> out_weights);
+
+// --- filter -------------------------------------------------------------------------------------
+// Per slot, carried from frame to frame: the simulator's velocity and theta through critically
+// damped springs (APM; the other modes take them as they are).
+struct FilterState {
+  std::span<glm::vec2> vel, vel_rate;  // [m/s], [m/s^2]
+  std::span<float> theta, theta_rate;  // unwrapped [rad], [rad/s]
+};
+// Per agent: the frame's values with unusable ones replaced by the agent's last good ones.
+struct SanitisedInput {
+  std::span<glm::vec2> positions;   // [m]
+  std::span<glm::vec2> velocities;  // [m/s]
+  std::span<float> thetas;          // [rad]
+};
+// Reads the frame, last frame's filter state and drawn root (a bad p holds it). Writes the
+// sanitised input (per agent), the filter state, the filtered speed and `standing`.
+void filter_pass(const PassCrowd& crowd, const AgentFrame& frame,
+                 std::span<const glm::vec2> root_xz, FilterState state, SanitisedInput out,
+                 std::span<float> out_speed_m_s, std::span<uint8_t> out_standing);
+
+// --- root ---------------------------------------------------------------------------------------
+// Reads the sanitised positions (per agent), the filtered velocity, `standing` and last frame's
+// lower-body yaw. Writes the drawn root (predicted with the filtered velocity and pulled onto p,
+// never far from it) and its heading, the direction it travels [rad] (the lower body's yaw when
+// standing).
+void root_pass(const PassCrowd& crowd, std::span<const glm::vec2> positions,
+               std::span<const glm::vec2> vel, std::span<const uint8_t> standing,
+               std::span<const float> lower_yaw, std::span<glm::vec2> root_xz,
+               std::span<float> out_root_heading);
+
+// --- facing -------------------------------------------------------------------------------------
+// Reads the root's heading, the filtered theta and `standing`. Writes the lower body's target
+// and yaw psi (turned toward the target at a limited rate; APM picks the direction group that
+// leaves the torso the least twist), the upper body's yaw and the travel direction relative to psi
+// (0 standing or outside APM) [rad].
+void facing_pass(const PassCrowd& crowd, std::span<const float> root_heading,
+                 std::span<const float> theta, std::span<const uint8_t> standing,
+                 std::span<float> lower_target, std::span<float> lower_yaw,
+                 std::span<float> out_upper_yaw, std::span<float> out_rel_dir);
+
+// --- weights ------------------------------------------------------------------------------------
+// Per slot [slot * num_clips + clip]: the faded clip weights (carried) and the target ones.
+struct ClipWeights {
+  std::span<float> faded;
+  std::span<float> target;  // scratch
+};
+// Reads the filtered speed and the relative travel direction. Writes the clip weights (faded
+// toward the target over the blend time in APM, switched at once otherwise), the blend progress,
+// and the layers: the kMaxBlendLayers heaviest clips [slot * kMaxBlendLayers + k], normalised.
+// A layer of weight 0 keeps the clip it had.
+void weights_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
+                  std::span<const float> rel_dir, ClipWeights weights,
+                  std::span<int16_t> layer_clip, std::span<float> layer_weight,
+                  std::span<float> out_blend_progress);
+
+// --- rate and phase -----------------------------------------------------------------------------
+// Reads the layers, the filtered speed, each agent's cadence scale and the lower-body yaw. Writes
+// the playback rate (speed over the blend's native speed, within the rate limits; 1 without gait
+// clips), the gait phase (advanced by the blend's cycle frequency times the rate), the standing
+// clip's clock, the share of gait clips and the travel direction the played clips imply [rad].
+void rate_phase_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
+                     std::span<const float> layer_weight, std::span<const float> speed_m_s,
+                     std::span<const float> cadence_scale, std::span<const float> lower_yaw,
+                     std::span<float> phase, std::span<float> idle_time_s,
+                     std::span<float> out_playback_rate, std::span<float> out_gait_weight,
+                     std::span<float> out_travel_yaw);
+
+// --- contacts -----------------------------------------------------------------------------------
+// Per slot, per foot: what the clips do with each foot this frame.
+struct ContactPlans {
+  std::span<float> plant[2];           // "a lock may start", 0..1
+  std::span<float> hold[2];            // "keep the lock", 0..1
+  std::span<float> swing_progress[2];  // 0 at lift-off, 1 at landing
+  std::span<float> gait_toe_y[2];      // the gait clips' own toe height [m]
+  std::span<float> double_support;     // share of the voting clips that walk, 0..1
+};
+// Reads the layers, the phase, the standing clip's clock and the share of gait clips. Writes each
+// layer's clip time (phase-synchronised: a new clip starts in phase) and the feet's contacts,
+// voted by the gait clips alone once they carry a quarter of the blend.
+void contacts_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
+                   std::span<const float> layer_weight, std::span<const float> phase,
+                   std::span<const float> idle_time_s, std::span<const float> gait_weight,
+                   std::span<float> out_layer_time_s, ContactPlans out);
+
+// --- feedback -----------------------------------------------------------------------------------
+// Per agent, index-aligned with the frame.
+struct FeedbackOut {
+  std::span<uint8_t> has_feedback;
+  std::span<glm::vec2> positions, velocities;
+  std::span<float> thetas;
+};
+// Reads the sanitised input (per agent), the lower-body yaw, `standing` and the share of gait
+// clips. Writes the feedback (per agent): the sanitised input, unflagged, unless `honoured` (APM
+// with feedback on and a source that takes it) and the animation cannot deliver it: a speed above
+// the fastest clip's reach, with forward clips only a velocity turning away from psi faster than
+// the legs, or a theta beyond the torsion limit.
+void feedback_pass(const PassCrowd& crowd, bool honoured, std::span<const glm::vec2> positions,
+                   std::span<const glm::vec2> velocities, std::span<const float> thetas,
+                   std::span<const float> lower_yaw, std::span<const uint8_t> standing,
+                   std::span<const float> gait_weight, FeedbackOut out);
+
+}  // namespace gk
