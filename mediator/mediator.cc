@@ -103,6 +103,9 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   cadence_scale_.assign(capacity, 1.0f);
   fade_.assign(capacity, 1.0f);
   dominant_.assign(capacity, static_cast<int16_t>(library.idle));
+  lod_elapsed_s_.assign(capacity, 0.0f);
+  lod_phase_advance_.assign(capacity, 0.0f);
+  lod_root_at_plan_.assign(capacity, glm::vec2(0.0f));
 }
 
 void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v,
@@ -263,8 +266,16 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   const bool feedback = params_.feedback && policy == FeedbackPolicy::kHonoured;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
-      plan_agent(static_cast<int>(i), plans_.slot_of_agent[i], frame.positions[i],
-                 frame.velocities[i], frame.thetas[i], dt_s, feedback);
+      const int slot = plans_.slot_of_agent[i];
+      if (!lod_due_.empty() && !lod_due_[slot] && !plans_.fresh[slot]) {
+        advance_agent(static_cast<int>(i), slot, frame.positions[i], frame.velocities[i],
+                      frame.thetas[i], dt_s);
+        continue;
+      }
+      plan_agent(static_cast<int>(i), slot, frame.positions[i], frame.velocities[i],
+                 frame.thetas[i], lod_due_.empty() ? dt_s : lod_step(slot, dt_s), feedback);
+      lod_root_at_plan_[slot] = plans_.root_xz[slot];
+      lod_elapsed_s_[slot] = lod_phase_advance_[slot] = 0.0f;
     }
   });
   for (size_t i = 0; i < n; ++i) {
@@ -513,6 +524,70 @@ void Mediator::plan_agent(int agent, int slot, const glm::vec2& p_in, const glm:
   pl.phase[slot] = phase_[slot];
   pl.blend_progress[slot] = fade_[slot];
   pl.standing[slot] = standing;
+}
+
+// LOD: the agent's phase, clip times and idle clock advance with the rate of its last plan, and
+// its root follows p as plan_agent's would (predicted with the filtered velocity, pulled onto p,
+// never more than kMaxRootOffset away). Clips, weights, facing and springs wait for its next plan.
+void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const glm::vec2& v_in,
+                             float theta_in, float dt) {
+  AnimationPlans& pl = plans_;
+  const glm::vec2 p = usable_position(p_in) ? p_in : pl.root_xz[slot];
+  glm::vec2 v = finite2(v_in) ? v_in : vel_[slot];
+  if (glm::length(v) > kAbsurdSpeed) v = vel_[slot];
+  sim_vel_[agent] = v;
+  feedback_.has_feedback[agent] = 0;
+  feedback_.positions[agent] = p;
+  feedback_.velocities[agent] = v;
+  feedback_.thetas[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];
+  if (params_.mode == MediatorMode::kApm) {
+    const glm::vec2 predicted = pl.root_xz[slot] + vel_[slot] * dt;
+    glm::vec2 root = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
+    const glm::vec2 off = root - p;
+    const float len = glm::length(off);
+    if (len > kMaxRootOffset) root = p + off * (kMaxRootOffset / len);
+    pl.root_xz[slot] = root;
+  } else {
+    pl.root_xz[slot] = p;
+  }
+  // The gait frequency of the planned blend, as plan_agent computes it.
+  const int16_t* lc = &pl.layer_clip[slot * kMaxBlendLayers];
+  const float* lw = &pl.layer_weight[slot * kMaxBlendLayers];
+  float* lt = &pl.layer_time_s[slot * kMaxBlendLayers];
+  float freq = 0.0f, gait_w = 0.0f;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const LocomotionClip& clip = library_.clips[lc[k]];
+    if (clip.gait && lw[k] > 0.0f) {
+      freq += lw[k] / clip.cycle_s;
+      gait_w += lw[k];
+    }
+  }
+  if (gait_w > 0.0f) {
+    const float step = freq / gait_w * pl.playback_rate[slot] * dt;
+    phase_[slot] = std::fmod(phase_[slot] + step, 1.0f);
+    lod_phase_advance_[slot] += step;
+  }
+  idle_time_[slot] += dt;
+  lod_elapsed_s_[slot] += dt;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const LocomotionClip& clip = library_.clips[lc[k]];
+    lt[k] = clip.gait ? clip.time_at_phase(phase_[slot])
+                      : std::fmod(idle_time_[slot], std::max(clip.clip.duration_s(), 1e-3f));
+  }
+  pl.phase[slot] = phase_[slot];
+}
+
+// LOD: the step [s] a due agent is planned over: the time since its last plan. The phase, idle
+// clock and root are taken back to where that plan left them, so that plan_agent advances them
+// once over the whole step (its root filter predicts from the last plan's root).
+float Mediator::lod_step(int slot, float dt) {
+  if (plans_.fresh[slot] || lod_elapsed_s_[slot] <= 0.0f) return dt;
+  const float elapsed = lod_elapsed_s_[slot] + dt;
+  phase_[slot] -= std::fmod(lod_phase_advance_[slot], 1.0f);
+  if (phase_[slot] < 0.0f) phase_[slot] += 1.0f;
+  idle_time_[slot] -= lod_elapsed_s_[slot];
+  plans_.root_xz[slot] = lod_root_at_plan_[slot];
+  return std::min(elapsed, 1.0f);
 }
 
 }  // namespace gk

@@ -48,6 +48,14 @@ class Mediator {
   Status plan(const AgentFrame& frame, float dt_s,
               FeedbackPolicy policy = FeedbackPolicy::kHonoured);
 
+  // Level of detail (pipeline/lod.h): from the next plan() on, only the slots whose flag is set
+  // (and fresh agents) are planned; the others keep their clips, blend and facing while their
+  // phase and clip times advance with the planned rate and their root follows the simulator, and
+  // they get no feedback. A planned agent's springs, fades and turn limits then step over the
+  // whole time since its last plan. Empty (the default): every agent every frame. The span must
+  // stay valid (capacity long) while it is set.
+  void set_lod_due(std::span<const uint8_t> due_by_slot) { lod_due_ = due_by_slot; }
+
   const AnimationPlans& plans() const { return plans_; }
   const FeedbackBuffers& feedback() const { return feedback_; }
   size_t num_agents() const { return num_agents_; }
@@ -67,6 +75,10 @@ class Mediator {
   void plan_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
                   float dt, bool feedback);
   void choose_weights(int slot, float speed, float rel_dir, float* out_w) const;
+  // LOD: an agent that is not due (set_lod_due), and the step of one that is.
+  void advance_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
+                     float dt);
+  float lod_step(int slot, float dt);
 
   const LocomotionLibrary& library_;
   MediatorParams params_;
@@ -92,6 +104,10 @@ class Mediator {
   std::vector<float> fade_;                // blend progress
   std::vector<int16_t> dominant_;          // clip with the largest target weight
   std::vector<float> scratch_target_;      // [slot * num_clips]
+  // LOD, per slot: time [s], phase and root advance since the slot's last plan.
+  std::span<const uint8_t> lod_due_;
+  std::vector<float> lod_elapsed_s_, lod_phase_advance_;
+  std::vector<glm::vec2> lod_root_at_plan_;
 };
 
 }  // namespace gk
