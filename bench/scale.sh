@@ -105,6 +105,7 @@ done
   echo "$load_start at the start, $(cut -d' ' -f1-3 /proc/loadavg) at the end (wall-clock medians: a"
   echo "loaded machine inflates every stage). Plaza scenario, 60 Hz, LOD distances 15 / 30 / 60 m from"
   echo "the scenario's centre; levels are updated every 1 / 2 / 4 / 8 frames (docs/pipeline.md)."
+  echo "This run: rigs $rigs; agents $agents_list; threads $threads_list; render at $render_list agents."
 } >> "$out.tmp"
 mv "$out.tmp" "$out"
 cat "$out"
