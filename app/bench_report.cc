@@ -84,6 +84,20 @@ json to_json(const BenchReport& r) {
   } else {
     out["crowd"] = nullptr;
   }
+  if (r.lod) {
+    const LodReport& l = *r.lod;
+    out["lod"] = {
+        {"focus_m", {l.focus_x_m, l.focus_z_m}},
+        {"distances_m", l.distances_m},
+        {"hysteresis_m", l.hysteresis_m},
+        {"periods_frames", {1, 2, 4, 8}},
+        {"mean_agents_per_level", l.mean_agents_per_level},
+        {"mean_agents_updated", l.mean_agents_updated},
+        {"metrics_cover", "level 0 (full detail) agents only"},
+    };
+  } else {
+    out["lod"] = nullptr;
+  }
   return out;
 }
 
@@ -123,6 +137,16 @@ std::string summary(const BenchReport& r) {
     s += "; min pair distance " +
          (c.min_pair_distance_m ? fixed(*c.min_pair_distance_m, 3) + " m" : std::string("n/a")) +
          "\n";
+  }
+  if (r.lod) {
+    const LodReport& l = *r.lod;
+    s += "  lod: focus (" + fixed(l.focus_x_m, 1) + ", " + fixed(l.focus_z_m, 1) + ") m, levels at " +
+         fixed(l.distances_m[0], 1) + " / " + fixed(l.distances_m[1], 1) + " / " +
+         fixed(l.distances_m[2], 1) + " m; agents per level (every 1/2/4/8 frames) " +
+         fixed(l.mean_agents_per_level[0], 0) + " / " + fixed(l.mean_agents_per_level[1], 0) +
+         " / " + fixed(l.mean_agents_per_level[2], 0) + " / " +
+         fixed(l.mean_agents_per_level[3], 0) + ", updated per frame " +
+         fixed(l.mean_agents_updated, 0) + "; metrics: level 0 agents only\n";
   }
   if (r.metrics) {
     const nlohmann::json& m = *r.metrics;

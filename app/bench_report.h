@@ -77,6 +77,17 @@ struct CrowdReport {
   int pair_distance_every_frames = 10;
 };
 
+// Level of detail of the run (pipeline/lod.h), when --lod was given.
+struct LodReport {
+  double focus_x_m = 0.0, focus_z_m = 0.0;
+  std::array<double, 3> distances_m{};
+  double hysteresis_m = 0.0;
+  // Live agents at each level, mean over the timed frames (after warm-up).
+  std::array<double, 4> mean_agents_per_level{};
+  // Planned and posed agents per frame (due), mean over the timed frames.
+  double mean_agents_updated = 0.0;
+};
+
 struct BenchReport {
   std::string gaitkeeper_version;
   std::string scenario;
@@ -101,6 +112,7 @@ struct BenchReport {
   std::optional<double> us_per_agent;     // median total / agents * 1000
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists
   std::optional<CrowdReport> crowd;
+  std::optional<LodReport> lod;  // null without --lod
 };
 
 nlohmann::json to_json(const BenchReport& report);

@@ -43,7 +43,32 @@ struct BenchOptions {
   bool render = false;
   std::string size = "1280x720";
   std::string progress_every = "0";
+  bool lod = false;
+  std::string lod_distances;
+  std::string lod_focus;
 };
+
+// --lod, --lod-distances a,b,c and --lod-focus X,Z (default: the centre of the scenario's region).
+LodParams lod_params(const BenchOptions& o, const CrowdSession& session) {
+  LodParams p;
+  p.enabled = o.lod;
+  p.focus = 0.5f * (session.bounds_min() + session.bounds_max());
+  if (!o.lod_distances.empty()) {
+    if (Status s = parse_lod_distances(o.lod_distances, "--lod-distances", &p); !s.ok()) {
+      app::fail("bench", 2, s.message());
+    }
+  }
+  if (!o.lod_focus.empty()) {
+    float x = 0.0f, z = 0.0f;
+    char tail = 0;
+    if (std::sscanf(o.lod_focus.c_str(), "%f,%f%c", &x, &z, &tail) != 2 || !std::isfinite(x) ||
+        !std::isfinite(z)) {
+      app::fail("bench", 2, "--lod-focus: expected X,Z [m], got '" + o.lod_focus + "'");
+    }
+    p.focus = glm::vec2(x, z);
+  }
+  return p;
+}
 
 // One line of --progress-every: the window of frames since the previous line.
 struct ProgressWindow {
@@ -149,6 +174,13 @@ void run_bench(const BenchOptions& o) {
     std::fprintf(stderr, "gaitkeeper bench: only %d frames; the first %d are warm-up and untimed\n",
                  frames, kWarmupFrames);
   }
+  const LodParams lod = lod_params(o, *session);
+  if (!o.lod && (!o.lod_distances.empty() || !o.lod_focus.empty())) {
+    fail(2, "--lod-distances and --lod-focus need --lod");
+  }
+  if (Status s = session->pipeline().set_lod(lod); !s.ok()) fail(2, s.message());
+  LodReport lod_stats;
+  int64_t lod_frames = 0;
   const LocomotionLibrary& library = session->library();
   const MediatorParams& params = session->params();
   const MetricsRecorder& metrics = *session->pipeline().metrics();
@@ -206,6 +238,20 @@ void run_bench(const BenchOptions& o) {
       if (!drawn.ok()) fail(1, "frame " + std::to_string(f) + ": " + drawn.message());
     }
     const double frame_total_ms = StageTimer::ms_since(frame_start) - measured_in_step.measure_ms;
+    if (o.lod && f >= kWarmupFrames) {
+      const LodPolicy& levels = session->pipeline().lod();
+      for (int k = 0; k < kNumLodLevels; ++k) {
+        lod_stats.mean_agents_per_level[k] += static_cast<double>(levels.counts()[k]);
+      }
+      const AnimationPlans& pl = session->pipeline().plans();
+      int64_t updated = 0;
+      for (size_t i = 0; i < session->frame().size(); ++i) {
+        const int slot = pl.slot_of_agent[i];
+        updated += levels.due()[slot] || pl.fresh[slot];
+      }
+      lod_stats.mean_agents_updated += static_cast<double>(updated);
+      ++lod_frames;
+    }
     const double frame_cpu_ms =
         progress_every > 0 ? process_cpu_ms() - frame_cpu_start_ms - measured_in_step.measure_cpu_ms
                            : 0.0;
@@ -306,6 +352,16 @@ void run_bench(const BenchOptions& o) {
     crowd_stats.removed = static_cast<int64_t>(st.removed);
   }
   report.crowd = crowd_stats;
+  if (o.lod) {
+    lod_stats.focus_x_m = lod.focus.x;
+    lod_stats.focus_z_m = lod.focus.y;
+    for (int k = 0; k < kNumLodLevels - 1; ++k) lod_stats.distances_m[k] = lod.distances_m[k];
+    lod_stats.hysteresis_m = lod.hysteresis_m;
+    const double n = static_cast<double>(std::max<int64_t>(lod_frames, 1));
+    for (double& v : lod_stats.mean_agents_per_level) v /= n;
+    lod_stats.mean_agents_updated /= n;
+    report.lod = lod_stats;
+  }
   report.mode = std::string(mediator_mode_name(params.mode));
   report.joints = library.skeleton->num_joints();
   report.clips = library.clip_names();
@@ -360,6 +416,15 @@ void add_bench_command(CLI::App& app) {
                   "frame_ms_max, wall_ms_per_frame, us_per_agent_frame, cpu_ms and "
                   "cpu_us_per_agent_frame (process CPU time of the pipeline), rss_kib, non_finite "
                   "counts (0 = off)");
+  cmd->add_flag("--lod", options->lod,
+                "Level of detail by distance to a focus point: agents planned and posed every "
+                "frame (level 0, full detail) or every 2nd / 4th / 8th frame with fewer details "
+                "(no foot locks; from level 2 no spine twist); the metrics then cover level 0 "
+                "agents only (docs/pipeline.md)");
+  cmd->add_option("--lod-distances", options->lod_distances,
+                  "With --lod: level boundaries a,b,c [m] (default 15,30,60)");
+  cmd->add_option("--lod-focus", options->lod_focus,
+                  "With --lod: the focus point X,Z [m] (default: the centre of the scenario)");
   cmd->add_option("--dump-joints", options->dump_joints,
                   "Write world joint positions per frame and agent to this CSV");
   cmd->add_option("--dump-joint-names", options->dump_joint_names,

@@ -106,6 +106,7 @@ class DemoApp {
   void panel_view();
   void panel_metrics();
   void panel_agent();
+  void panel_lod();  // level of detail of the primary lane, focused on the camera
   void handle_browser();
   void handle_input();  // app/demo_input.cc
   void feed_scripted_input(int frame);
@@ -129,6 +130,7 @@ class DemoApp {
   LiveMetrics compare_metrics_;  // the naive lane, shown beside the primary in compare mode
   OverlayToggles overlays_;
   OrbitCamera camera_;
+  LodParams lod_;  // the panel's level of detail; its focus follows the camera
   CameraDirector director_;
   SimClock clock_;
   bool camera_set_ = false;

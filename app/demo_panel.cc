@@ -1,6 +1,7 @@
 // The demo's Dear ImGui panel: crowd (rebuilds the session; files picked with a folder browser),
 // the loaded clips, mediator parameters (live, in plain words; saved and loaded as JSON), view and
 // overlays, live metrics with plots, per-stage timings, and the selected agent's animation state.
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
@@ -69,9 +70,47 @@ void DemoApp::draw_panel() {
   if (ImGui::CollapsingHeader("Stride and cadence against speed")) panel_gait();
   if (ImGui::CollapsingHeader("Metrics", ImGuiTreeNodeFlags_DefaultOpen)) panel_metrics();
   if (ImGui::CollapsingHeader("Selected agent", ImGuiTreeNodeFlags_DefaultOpen)) panel_agent();
+  if (ImGui::CollapsingHeader("Level of detail")) panel_lod();
   if (ImGui::CollapsingHeader("Clips")) panel_clips();
   if (ImGui::CollapsingHeader("Mediator parameters")) panel_params();
   ImGui::End();
+  // The focus is the camera's eye on the ground, every frame (also with the section closed).
+  if (session_) {
+    const glm::vec3 eye = camera_.eye();
+    lod_.focus = glm::vec2(eye.x, eye.z);
+    if (Status s = session_->pipeline().set_lod(lod_); !s.ok()) lod_.enabled = false;
+  }
+}
+
+void DemoApp::panel_lod() {
+  row("Level of detail");
+  ImGui::Checkbox("##lod", &lod_.enabled);
+  help_marker(
+      "Agents far from the camera are planned and posed less often and with less: level 0 every "
+      "frame with everything, 1 every 2nd frame without foot locks, 2 every 4th and 3 every 8th "
+      "also without spine twist. Between updates their phase advances and their body follows the "
+      "simulator. The metrics then cover level 0 agents only. (primary lane; docs/pipeline.md)");
+  row("Boundaries [m]");
+  float d[3] = {lod_.distances_m[0], lod_.distances_m[1], lod_.distances_m[2]};
+  if (ImGui::DragFloat3("##lod_d", d, 0.5f, 0.0f, 1000.0f, "%.1f")) {
+    d[1] = std::max(d[1], d[0]);
+    d[2] = std::max(d[2], d[1]);
+    for (int k = 0; k < 3; ++k) lod_.distances_m[k] = d[k];
+  }
+  help_marker("distances_m: levels 1, 2 and 3 start this far from the camera [m]");
+  row("Hysteresis [m]");
+  ImGui::SliderFloat("##lod_h", &lod_.hysteresis_m, 0.0f, 10.0f, "%.1f");
+  help_marker("hysteresis_m: a level changes only this far past its boundary [m], so agents on a "
+              "boundary do not flicker");
+  if (!lod_.enabled || !session_) {
+    ImGui::TextDisabled("off: every agent at full detail");
+    return;
+  }
+  const LodPolicy& lod = session_->pipeline().lod();
+  ImGui::Text("agents per level: %lld / %lld / %lld / %lld",
+              static_cast<long long>(lod.counts()[0]), static_cast<long long>(lod.counts()[1]),
+              static_cast<long long>(lod.counts()[2]), static_cast<long long>(lod.counts()[3]));
+  ImGui::TextDisabled("every 1 / 2 / 4 / 8 frames; metrics: level 0 only");
 }
 
 void DemoApp::panel_crowd() {

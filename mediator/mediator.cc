@@ -58,6 +58,11 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   scratch_target_.assign(capacity * nc, 0.0f);
   idle_time_.assign(capacity, 0.0f);
   cadence_scale_.assign(capacity, 1.0f);
+  lod_plan_.assign(capacity, 1);
+  lod_dt_s_.assign(capacity, 0.0f);
+  lod_elapsed_s_.assign(capacity, 0.0f);
+  lod_phase_advance_.assign(capacity, 0.0f);
+  lod_root_at_plan_.assign(capacity, glm::vec2(0.0f));
 }
 
 void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v,
@@ -176,9 +181,31 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
     if (!sane_input(frame.positions[i], frame.velocities[i], frame.thetas[i])) ++num_sanitised_;
   }
 
-  // The whole-crowd passes (mediator/mediator_passes.h), each over every agent, in order.
+  // Level of detail: the agents not due this frame are advanced, not planned; a due one is
+  // planned over the time since its last plan.
   AnimationPlans& pl = plans_;
-  const PassCrowd crowd{library_, params_, dt_s, {pl.slot_of_agent.data(), n}, pl.fresh};
+  const bool lod = !lod_due_.empty();
+  if (lod) {
+    for (size_t i = 0; i < n; ++i) {
+      const int slot = pl.slot_of_agent[i];
+      lod_plan_[slot] = lod_due_[slot] || pl.fresh[slot];
+      if (lod_plan_[slot]) {
+        lod_dt_s_[slot] = lod_step(slot, dt_s);
+      } else {
+        advance_agent(static_cast<int>(i), slot, frame.positions[i], frame.velocities[i],
+                      frame.thetas[i], dt_s);
+      }
+    }
+  }
+
+  // The whole-crowd passes (mediator/mediator_passes.h), each over every agent due, in order.
+  const PassCrowd crowd{library_,
+                        params_,
+                        dt_s,
+                        {pl.slot_of_agent.data(), n},
+                        pl.fresh,
+                        lod ? std::span<const uint8_t>(lod_plan_) : std::span<const uint8_t>(),
+                        lod ? std::span<const float>(lod_dt_s_) : std::span<const float>()};
   filter_pass(crowd, frame, pl.root_xz, {vel_, vel_rate_, theta_, theta_rate_},
               {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
   root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_);
@@ -199,7 +226,81 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
       crowd, params_.feedback && policy == FeedbackPolicy::kHonoured, sim_pos_, sim_vel_,
       sim_theta_, pl.lower_yaw, pl.standing, pl.gait_weight,
       {feedback_.has_feedback, feedback_.positions, feedback_.velocities, feedback_.thetas});
+  if (lod) {
+    for (size_t i = 0; i < n; ++i) {
+      const int slot = pl.slot_of_agent[i];
+      if (!lod_plan_[slot]) continue;
+      lod_root_at_plan_[slot] = pl.root_xz[slot];
+      lod_elapsed_s_[slot] = lod_phase_advance_[slot] = 0.0f;
+    }
+  }
   return Status::Ok();
+}
+
+// LOD: the agent's phase, clip times and idle clock advance with the rate of its last plan, and
+// its root follows p as plan_agent's would (predicted with the filtered velocity, pulled onto p,
+// never more than kMaxRootOffset away). Clips, weights, facing and springs wait for its next plan.
+void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const glm::vec2& v_in,
+                             float theta_in, float dt) {
+  AnimationPlans& pl = plans_;
+  const glm::vec2 p = usable_position(p_in) ? p_in : pl.root_xz[slot];
+  glm::vec2 v = finite2(v_in) ? v_in : vel_[slot];
+  if (glm::length(v) > kAbsurdSpeed) v = vel_[slot];
+  sim_pos_[agent] = p;
+  sim_vel_[agent] = v;
+  sim_theta_[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];
+  feedback_.has_feedback[agent] = 0;
+  feedback_.positions[agent] = p;
+  feedback_.velocities[agent] = v;
+  feedback_.thetas[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];
+  if (params_.mode == MediatorMode::kApm) {
+    const glm::vec2 predicted = pl.root_xz[slot] + vel_[slot] * dt;
+    glm::vec2 root = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
+    const glm::vec2 off = root - p;
+    const float len = glm::length(off);
+    if (len > kMaxRootOffset) root = p + off * (kMaxRootOffset / len);
+    pl.root_xz[slot] = root;
+  } else {
+    pl.root_xz[slot] = p;
+  }
+  // The gait frequency of the planned blend, as plan_agent computes it.
+  const int16_t* lc = &pl.layer_clip[slot * kMaxBlendLayers];
+  const float* lw = &pl.layer_weight[slot * kMaxBlendLayers];
+  float* lt = &pl.layer_time_s[slot * kMaxBlendLayers];
+  float freq = 0.0f, gait_w = 0.0f;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const LocomotionClip& clip = library_.clips[lc[k]];
+    if (clip.gait && lw[k] > 0.0f) {
+      freq += lw[k] / clip.cycle_s;
+      gait_w += lw[k];
+    }
+  }
+  if (gait_w > 0.0f) {
+    const float step = freq / gait_w * pl.playback_rate[slot] * dt;
+    pl.phase[slot] = std::fmod(pl.phase[slot] + step, 1.0f);
+    lod_phase_advance_[slot] += step;
+  }
+  idle_time_[slot] += dt;
+  lod_elapsed_s_[slot] += dt;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const LocomotionClip& clip = library_.clips[lc[k]];
+    lt[k] = clip.gait ? clip.time_at_phase(pl.phase[slot])
+                      : std::fmod(idle_time_[slot], std::max(clip.clip.duration_s(), 1e-3f));
+  }
+}
+
+// LOD: the step [s] a due agent is planned over: the time since its last plan. The phase, idle
+// clock and root are taken back to where that plan left them, so that plan_agent advances them
+// once over the whole step (its root filter predicts from the last plan's root).
+float Mediator::lod_step(int slot, float dt) {
+  if (plans_.fresh[slot] || lod_elapsed_s_[slot] <= 0.0f) return dt;
+  const float elapsed = lod_elapsed_s_[slot] + dt;
+  float& phase = plans_.phase[slot];
+  phase -= std::fmod(lod_phase_advance_[slot], 1.0f);
+  if (phase < 0.0f) phase += 1.0f;
+  idle_time_[slot] -= lod_elapsed_s_[slot];
+  plans_.root_xz[slot] = lod_root_at_plan_[slot];
+  return std::min(elapsed, 1.0f);
 }
 
 }  // namespace gk

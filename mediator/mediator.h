@@ -50,6 +50,14 @@ class Mediator {
   Status plan(const AgentFrame& frame, float dt_s,
               FeedbackPolicy policy = FeedbackPolicy::kHonoured);
 
+  // Level of detail (pipeline/lod.h): from the next plan() on, only the slots whose flag is set
+  // (and fresh agents) are planned; the others keep their clips, blend and facing while their
+  // phase and clip times advance with the planned rate and their root follows the simulator, and
+  // they get no feedback. A planned agent's springs, fades and turn limits then step over the
+  // whole time since its last plan. Empty (the default): every agent every frame. The span must
+  // stay valid (capacity long) while it is set.
+  void set_lod_due(std::span<const uint8_t> due_by_slot) { lod_due_ = due_by_slot; }
+
   const AnimationPlans& plans() const { return plans_; }
   const FeedbackBuffers& feedback() const { return feedback_; }
   size_t num_agents() const { return num_agents_; }
@@ -69,6 +77,11 @@ class Mediator {
   // slots: known agents keep their slots, vanished ones free theirs, newcomers are initialised.
   void assign_slots(const AgentFrame& frame);
   void init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v, float theta);
+  // LOD: an agent that is not due this frame (set_lod_due) is advanced, not planned; the step a
+  // due one is planned over (the time since its last plan).
+  void advance_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
+                     float dt);
+  float lod_step(int slot, float dt);
 
   const LocomotionLibrary& library_;
   MediatorParams params_;
@@ -96,6 +109,13 @@ class Mediator {
   std::vector<float> root_heading_;    // root pass -> facing pass
   std::vector<float> rel_dir_;         // facing pass -> weights pass
   std::vector<float> scratch_target_;  // [slot * num_clips]: the weights pass's target weights
+  // LOD, per slot: whether it is planned this frame, the step it is planned over [s], and the
+  // time [s], phase and root advance since its last plan.
+  std::span<const uint8_t> lod_due_;
+  std::vector<uint8_t> lod_plan_;
+  std::vector<float> lod_dt_s_;
+  std::vector<float> lod_elapsed_s_, lod_phase_advance_;
+  std::vector<glm::vec2> lod_root_at_plan_;
 };
 
 }  // namespace gk

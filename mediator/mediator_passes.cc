@@ -13,20 +13,21 @@ namespace gk {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-constexpr float kRootPullTime = 0.25f;   // [s] how fast the rendered root is pulled onto p
-constexpr float kMaxRootOffset = 0.06f;  // [m] the rendered root never strays further from p
 constexpr float kSwitchHysteresis =
     0.26f;  // [rad] a new travel direction group must be this much better
 
 bool is_apm(const PassCrowd& c) { return c.params.mode == MediatorMode::kApm; }
 
-// Runs fn(agent, slot) for every agent of the frame, in parallel (blocks of 64 agents).
+// Runs fn(agent, slot) for every agent of the frame that is planned this frame (all of them
+// without a level of detail), in parallel (blocks of 64 agents).
 template <typename Fn>
 void for_each_agent(const PassCrowd& c, Fn&& fn) {
   const std::span<const int32_t> slots = c.slot_of_agent;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, slots.size(), 64),
                     [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t i = r.begin(); i < r.end(); ++i) fn(i, slots[i]);
+                      for (size_t i = r.begin(); i < r.end(); ++i) {
+                        if (c.plans(slots[i])) fn(i, slots[i]);
+                      }
                     });
 }
 
@@ -106,8 +107,8 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
                  std::span<uint8_t> out_standing) {
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);
-  const float dt = c.dt_s;
   for_each_agent(c, [&](size_t i, int slot) {
+    const float dt = c.dt(slot);
     // Sanitise what the simulator gave (NaN, absurd speeds): hold the last good values.
     const glm::vec2 p_in = frame.positions[i], v_in = frame.velocities[i];
     const glm::vec2 p = usable_position(p_in) ? p_in : root_xz[slot];
@@ -138,8 +139,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
                std::span<const float> lower_yaw, std::span<glm::vec2> root_xz,
                std::span<float> out_root_heading) {
   const bool apm = is_apm(c);
-  const float dt = c.dt_s;
   for_each_agent(c, [&](size_t i, int slot) {
+    const float dt = c.dt(slot);
     // Predicted with the filtered velocity and pulled onto p, so a simulator's frame-to-frame
     // jitter (velocity flips in a jam) does not shake the body, while a steady walk is tracked
     // without lag. Never more than kMaxRootOffset from p. The legs then walk where the drawn root
@@ -170,8 +171,8 @@ void facing_pass(const PassCrowd& c, std::span<const float> root_heading,
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);
-  const float dt = c.dt_s;
   for_each_agent(c, [&](size_t, int slot) {
+    const float dt = c.dt(slot);
     // The lower body follows v (or a strafe/backward orientation), the upper body faces theta.
     const float travel = root_heading[slot];
     const float theta = wrap_pi(theta_unwrapped[slot]);
@@ -214,8 +215,8 @@ void weights_pass(const PassCrowd& c, std::span<const float> speed_m_s,
   const MediatorParams& P = c.params;
   const size_t nc = lib.clips.size();
   const bool apm = is_apm(c);
-  const float dt = c.dt_s;
   for_each_agent(c, [&](size_t, int slot) {
+    const float dt = c.dt(slot);
     // Target blend weights, faded toward over the blend time (APM) or switched at once.
     const std::span<float> w = cw.faded.subspan(slot * nc, nc);
     const std::span<float> target_w = cw.target.subspan(slot * nc, nc);
@@ -267,8 +268,8 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                      std::span<float> out_travel_yaw) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
-  const float dt = c.dt_s;
   for_each_agent(c, [&](size_t, int slot) {
+    const float dt = c.dt(slot);
     // Playback rate from speed, within limits; the rest is stride warping (foot IK), beyond that
     // the deliverable speed goes back to the simulator (feedback).
     const int16_t* lc = &layer_clip[slot * kMaxBlendLayers];

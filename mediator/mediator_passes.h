@@ -38,7 +38,18 @@ struct PassCrowd {
   float dt_s;                              // [s] (0, 1]
   std::span<const int32_t> slot_of_agent;  // per agent: its slot
   std::span<const uint8_t> fresh;          // per slot: 1 on the agent's first frame
+  // Level of detail (empty: every agent, over dt_s): per slot, whether it is planned this frame,
+  // and the step [s] it is planned over (the time since its last plan).
+  std::span<const uint8_t> planned = {};
+  std::span<const float> step_s = {};
+
+  bool plans(int slot) const { return planned.empty() || planned[slot] != 0; }
+  float dt(int slot) const { return step_s.empty() ? dt_s : step_s[slot]; }
 };
+
+// The drawn root: pulled onto p this fast, and never further from it.
+inline constexpr float kRootPullTime = 0.25f;   // [s]
+inline constexpr float kMaxRootOffset = 0.06f;  // [m]
 
 // The simulator's values are garbage beyond these (NaN, 1e30, a velocity no body has).
 inline constexpr float kAbsurdSpeed = 15.0f;   // [m/s]

@@ -46,7 +46,7 @@ void MetricsRecorder::end_track(size_t slot) {
 }
 
 void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
-                             const PoseSynthesizer& poses) {
+                             const PoseSynthesizer& poses, std::span<const uint8_t> include) {
   const Skeleton& sk = *library_.skeleton;
   const AnimationPlans& pl = m.plans();
   const MediatorParams& P = m.params();
@@ -61,6 +61,7 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
     assert(slot_i >= 0 && static_cast<size_t>(slot_i) < capacity_);
     if (slot_i < 0 || static_cast<size_t>(slot_i) >= capacity_) continue;
     const size_t slot = static_cast<size_t>(slot_i);
+    if (!include.empty() && !include[slot]) continue;  // its track ends below
     const std::span<const glm::mat4> w = poses.world(slot_i);
     Track& t = tracks_[slot];
     // A track holds consecutive frames of one agent; one that vanished and came back starts anew

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -59,7 +60,10 @@ class MetricsRecorder {
   MetricsRecorder(const LocomotionLibrary& library, float frame_time_s, size_t capacity);
   // Records one frame after plan() and synthesis; `frame` is the crowd's frame the plan was for.
   // Agents of the previous frame that are missing from this one have left: their tracks end.
-  void record(const AgentFrame& frame, const Mediator& mediator, const PoseSynthesizer& poses);
+  // With `include_by_slot` (capacity long, level of detail: pipeline/lod.h) only the agents whose
+  // slot is flagged are recorded; an agent left out ends its track, as if it had left.
+  void record(const AgentFrame& frame, const Mediator& mediator, const PoseSynthesizer& poses,
+              std::span<const uint8_t> include_by_slot = {});
   // The figures so far, as if every live agent's track ended now; recording may go on.
   MetricsReport finish() const;
   // Agents followed now (tracks not yet ended).

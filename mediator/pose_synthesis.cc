@@ -117,6 +117,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   has_prev_.assign(capacity, 0);
   drop_.assign(capacity, 0.0f);
   drop_rate_.assign(capacity, 0.0f);
+  placed_xz_.assign(capacity, glm::vec2(0.0f));
   locks_.lock.assign(capacity * 2, FootLock());
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
@@ -145,6 +146,48 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
   });
 }
 
+void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorParams& P, float dt_s,
+                          std::span<const uint8_t> detail) {
+  tbb::enumerable_thread_specific<Scratch>& scratch = *scratch_;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 32), [&](const tbb::blocked_range<size_t>& r) {
+    Scratch& s = scratch.local();
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const int slot = pl.slot_of_agent[i];
+      const auto d = static_cast<PoseDetail>(detail[slot]);
+      if (d == PoseDetail::kHold && !pl.fresh[slot]) {
+        hold_agent(pl, slot);
+      } else {
+        synthesize_agent(pl, P, slot, dt_s, s, d == PoseDetail::kHold ? PoseDetail::kLight : d);
+      }
+    }
+  });
+}
+
+// An agent not posed this frame: its world joints, palette and foot positions move with the
+// root's ground translation since they were placed (one add per matrix; the facing and the pose
+// wait for the next update).
+void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
+  const glm::vec2 delta = pl.root_xz[slot] - placed_xz_[slot];
+  if (delta.x == 0.0f && delta.y == 0.0f) return;
+  placed_xz_[slot] = pl.root_xz[slot];
+  const size_t base = static_cast<size_t>(slot) * num_joints_;
+  for (int j = 0; j < num_joints_; ++j) {
+    world_[base + j][3].x += delta.x;
+    world_[base + j][3].z += delta.y;
+  }
+  if (make_palettes_) {
+    for (int j = 0; j < num_joints_; ++j) {
+      palette_[base + j][3].x += delta.x;
+      palette_[base + j][3].z += delta.y;
+    }
+  }
+  for (int side = 0; side < 2; ++side) {
+    const size_t k = static_cast<size_t>(slot) * 2 + side;
+    locks_.drawn_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
+    locks_.anim_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
+  }
+}
+
 void PoseSynthesizer::fk_from(int slot, int first, const glm::mat4& root) {
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   for (int j = std::max(first, 0); j < num_joints_; ++j) {
@@ -156,7 +199,7 @@ void PoseSynthesizer::fk_from(int slot, int first, const glm::mat4& root) {
 }
 
 void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot,
-                                       float dt, Scratch& s) {
+                                       float dt, Scratch& s, PoseDetail detail) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   if (pl.fresh[slot]) {
@@ -198,11 +241,15 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   BlendPosesJob{{layers, static_cast<size_t>(num_layers)}, out_r, out_t}.run();
 
   const bool apm = P.mode == MediatorMode::kApm;
+  const bool locking = apm && P.foot_locking && detail == PoseDetail::kFull;
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
+  placed_xz_[slot] = pl.root_xz[slot];
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   fk_from(slot, 0, root);
-  if (apm) twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
-  if (apm && P.foot_locking) lock_feet(pl, P, slot, root, dt);
+  if (apm && detail != PoseDetail::kLight) {
+    twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
+  }
+  if (locking) lock_feet(pl, P, slot, root, dt);
 
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
@@ -224,11 +271,15 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
         translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
   }
-  if (!(apm && P.foot_locking)) {
+  if (!locking) {
+    // Foot locks (and the pelvis drop and raised heels that serve them) start afresh from the
+    // feet as drawn when they are next on.
+    drop_[slot] = drop_rate_[slot] = 0.0f;
     for (int side = 0; side < 2; ++side) {
       const size_t k = static_cast<size_t>(slot) * 2 + side;
       locks_.lock[k] = FootLock();
       locks_.anim_toe[k] = locks_.drawn_toe[k];
+      locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
     }
   }
   std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);

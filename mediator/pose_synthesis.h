@@ -20,6 +20,14 @@
 
 namespace gk {
 
+// How much of an agent's pose run() works out this frame (level of detail, pipeline/lod.h).
+enum class PoseDetail : uint8_t {
+  kFull = 0,         // everything: spine twist, foot locks and leg IK
+  kNoFootLocks = 1,  // spine twist, no foot locks (they start afresh from the drawn toes)
+  kLight = 2,        // no spine twist, no foot locks
+  kHold = 3,         // not posed: the last pose moves with the root (root_xz) to where it is now
+};
+
 // Per foot [slot * 2 + side].
 struct FootLocks {
   std::vector<FootLock> lock;          // the lock state machine (mediator/foot_lock.h)
@@ -38,6 +46,9 @@ class PoseSynthesizer {
   // plans.slot_of_agent[i]) with the parameters they were planned with.
   void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
            float dt_s);
+  // The same with a PoseDetail per slot (`detail_by_slot`, as uint8_t; capacity long).
+  void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
+           float dt_s, std::span<const uint8_t> detail_by_slot);
 
   int num_joints() const { return num_joints_; }
   // World transforms of one slot's joints, as rendered.
@@ -69,7 +80,8 @@ class PoseSynthesizer {
  private:
   struct Scratch;
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
-                        Scratch& s);
+                        Scratch& s, PoseDetail detail = PoseDetail::kFull);
+  void hold_agent(const AnimationPlans& pl, int slot);
   void fk_from(int slot, int first_joint, const glm::mat4& root);
   void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
   void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
@@ -94,6 +106,7 @@ class PoseSynthesizer {
   std::vector<uint8_t> has_prev_;
   std::vector<float> drop_;       // pelvis drop per slot [m]
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
+  std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   int first_leg_joint_ = 0;

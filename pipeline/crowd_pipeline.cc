@@ -44,7 +44,14 @@ CrowdPipeline::CrowdPipeline(const LocomotionLibrary& library, const MediatorPar
       metrics_(options.record_metrics
                    ? std::make_unique<MetricsRecorder>(library, options.frame_time_s, capacity_)
                    : nullptr),
-      snapshot_(capacity_) {}
+      snapshot_(capacity_),
+      lod_(capacity_) {}
+
+Status CrowdPipeline::set_lod(const LodParams& params) {
+  GK_RETURN_IF_ERROR(validate(params));
+  lod_params_ = params;
+  return Status::Ok();
+}
 
 CrowdPipeline::~CrowdPipeline() = default;
 
@@ -69,6 +76,10 @@ Status CrowdPipeline::follow(const AgentFrame& frame, FeedbackPolicy policy, flo
 Status CrowdPipeline::animate(const AgentFrame& frame, FeedbackPolicy policy, CrowdSource* source,
                               float dt_s) {
   auto t = Clock::now();
+  // Level of detail: which slots are planned and posed this frame (from the last frame's roots).
+  const bool lod = lod_params_.enabled;
+  if (lod) lod_.assign(mediator_->plans(), lod_params_, frames_run_);
+  mediator_->set_lod_due(lod ? lod_.due() : std::span<const uint8_t>());
   // plan() validates the frame before it writes anything: on failure the previous frame's plans,
   // snapshot and poses are untouched and still drawable.
   GK_RETURN_IF_ERROR(mediator_->plan(frame, dt_s, policy));
@@ -84,14 +95,21 @@ Status CrowdPipeline::animate(const AgentFrame& frame, FeedbackPolicy policy, Cr
 
   // Posed even when the source refused the feedback, so that plans and poses stay one frame.
   t = Clock::now();
-  poses_->run(plans, snapshot_.size, mediator_->params(), dt_s);
+  if (lod) {
+    poses_->run(plans, snapshot_.size, mediator_->params(), dt_s, lod_.pose_detail());
+  } else {
+    poses_->run(plans, snapshot_.size, mediator_->params(), dt_s);
+  }
   times_.pose_ms = ms_since(t);
   GK_RETURN_IF_ERROR(fed);
 
   t = Clock::now();
   const double cpu_start_ms = thread_cpu_ms();
   const AgentFrame planned = snapshot_.view();
-  if (metrics_) metrics_->record(planned, *mediator_, *poses_);
+  if (metrics_) {
+    metrics_->record(planned, *mediator_, *poses_,
+                     lod ? lod_.full_detail() : std::span<const uint8_t>());
+  }
   ++frames_run_;
   for (const FrameHook& hook : hooks_) {
     if (Status s = hook(*this); !s.ok()) {

@@ -35,6 +35,7 @@
 #include "mediator/metrics.h"
 #include "mediator/params.h"
 #include "mediator/pose_synthesis.h"
+#include "pipeline/lod.h"
 
 namespace gk {
 
@@ -109,6 +110,12 @@ class CrowdPipeline {
   // The streamed METRICS.md figures (null without record_metrics).
   const MetricsRecorder* metrics() const { return metrics_.get(); }
   void add_frame_hook(FrameHook hook) { hooks_.push_back(std::move(hook)); }
+  // Level of detail (pipeline/lod.h) from the next frame on; an error (and no change) when the
+  // parameters are out of their limits. Off by default: every agent at full detail.
+  Status set_lod(const LodParams& params);
+  const LodParams& lod_params() const { return lod_params_; }
+  // Levels, due flags and agents per level of the last frame (all level 0 with LOD off).
+  const LodPolicy& lod() const { return lod_; }
   const PipelineTimes& times() const { return times_; }
   int64_t frames_run() const { return frames_run_; }
 
@@ -125,6 +132,8 @@ class CrowdPipeline {
   size_t num_slots_ = 0;
   PipelineTimes times_;
   int64_t frames_run_ = 0;
+  LodParams lod_params_;
+  LodPolicy lod_;
 };
 
 }  // namespace gk

@@ -234,6 +234,42 @@ TEST(Cli, BenchLoopsAScenarioAndReportsProgress) {
   EXPECT_NE(r.out.find("v1 contact band excess"), std::string::npos) << r.out;
 }
 
+// Issue #11: --lod reports the agents per level (together the crowd) and that the metrics cover
+// level 0 only; bad LOD options are refused naming the option.
+TEST(Cli, BenchLodReportsAgentsPerLevel) {
+  const std::string json = test::scratch_dir("cli") + "/lod.json";
+  // The focus on one end of the corridor, where half the crowd starts.
+  CommandResult r = run("bench --scenario corridor --frames 120 --lod --lod-distances 3,6,12 "
+                        "--lod-focus 12,0 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("lod: focus"), std::string::npos) << r.out;
+  const nlohmann::json rep = read_json(json);
+  const nlohmann::json& lod = rep["lod"];
+  ASSERT_TRUE(lod.is_object()) << rep.dump();
+  double agents = 0.0;
+  for (const nlohmann::json& n : lod["mean_agents_per_level"]) agents += n.get<double>();
+  EXPECT_NEAR(agents, rep["crowd"]["mean_live_agents"].get<double>(), 1e-6);
+  EXPECT_GT(lod["mean_agents_per_level"][0].get<double>(), 0.0);
+  EXPECT_GT(lod["mean_agents_per_level"][3].get<double>(), 0.0);
+  EXPECT_LT(lod["mean_agents_updated"].get<double>(), agents);
+  EXPECT_EQ(lod["distances_m"][1].get<double>(), 6.0);
+  EXPECT_EQ(lod["focus_m"][0].get<double>(), 12.0);
+  EXPECT_NE(lod["metrics_cover"].get<std::string>().find("level 0"), std::string::npos);
+  // Without --lod the report says null.
+  r = run("bench --scenario corridor --frames 40 --json " + json);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(read_json(json)["lod"].is_null());
+  r = run("bench --scenario corridor --frames 10 --lod --lod-distances 8,4,12");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--lod-distances"), std::string::npos) << r.out;
+  r = run("bench --scenario corridor --frames 10 --lod --lod-focus 1,x");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--lod-focus"), std::string::npos) << r.out;
+  r = run("bench --scenario corridor --frames 10 --lod-distances 4,8,12");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("need --lod"), std::string::npos) << r.out;
+}
+
 TEST(Cli, BadParametersAreRefusedWithTheirLimits) {
   CommandResult r = run("bench --scenario corridor --frames 10 --set torsion_limit_deg=400");
   EXPECT_EQ(r.code, 2);
