@@ -116,17 +116,19 @@ bool BlendPosesJob::validate() const {
 
 void BlendPosesJob::run() const {
   float total = 0.0f;
-  int first = -1;
+  int first = -1, weighted = 0;
   for (size_t k = 0; k < layers.size(); ++k) {
     if (layers[k].weight > 0.0f) {
       total += layers[k].weight;
       if (first < 0) first = static_cast<int>(k);
+      ++weighted;
     }
   }
   const size_t n = out_rotations.size();
-  if (first < 0) {  // nothing weighted: fall back to the first layer unchanged
-    std::copy_n(layers[0].rotations.begin(), n, out_rotations.begin());
-    std::copy_n(layers[0].translations.begin(), n, out_translations.begin());
+  if (weighted <= 1) {  // one layer is the blend (unit rotations stay); none: the first unchanged
+    const PoseLayer& only = layers[std::max(first, 0)];
+    std::copy_n(only.rotations.begin(), n, out_rotations.begin());
+    std::copy_n(only.translations.begin(), n, out_translations.begin());
     return;
   }
   const float inv_total = 1.0f / total;
@@ -148,17 +150,27 @@ void BlendPosesJob::run() const {
 
 bool LocalToModelJob::validate() const {
   if (!skeleton) return false;
-  const size_t n = static_cast<size_t>(skeleton->num_joints());
-  return rotations.size() >= n && translations.size() >= n && out_model.size() >= n;
+  const int n = skeleton->num_joints();
+  const size_t un = static_cast<size_t>(n);
+  return rotations.size() >= un && translations.size() >= un && out_model.size() >= un &&
+         from >= 0 && from <= n && (to < 0 || (to >= from && to <= n));
 }
 
 void LocalToModelJob::run() const {
   const int n = skeleton->num_joints();
-  for (int j = 0; j < n; ++j) {
-    glm::mat4 local = glm::mat4_cast(rotations[j]);
-    local[3] = glm::vec4(translations[j], 1.0f);
+  const int end = to < 0 ? n : std::min(to, n);
+  for (int j = std::max(from, 0); j < end; ++j) {
     const int parent = skeleton->parents[j];
-    out_model[j] = (parent < 0 ? root_transform : out_model[parent]) * local;
+    const glm::mat4& p = parent < 0 ? root_transform : out_model[parent];
+    // p * [R t; 0 1], leaving out the products with the local matrix's zeros (the sums keep glm's
+    // order, so the result is glm's p * local to the bit).
+    const glm::mat3 r = glm::mat3_cast(rotations[j]);
+    const glm::vec3& t = translations[j];
+    glm::mat4& m = out_model[j];
+    m[0] = p[0] * r[0][0] + p[1] * r[0][1] + p[2] * r[0][2];
+    m[1] = p[0] * r[1][0] + p[1] * r[1][1] + p[2] * r[1][2];
+    m[2] = p[0] * r[2][0] + p[1] * r[2][1] + p[2] * r[2][2];
+    m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
   }
 }
 
@@ -251,7 +263,27 @@ bool SkinningPaletteJob::validate() const {
 }
 
 void SkinningPaletteJob::run() const {
-  for (size_t j = 0; j < model.size(); ++j) out_palette[j] = model[j] * inverse_bind[j];
+  if (!affine_inverse_bind) {
+    for (size_t j = 0; j < model.size(); ++j) out_palette[j] = model[j] * inverse_bind[j];
+    return;
+  }
+  for (size_t j = 0; j < model.size(); ++j) {
+    // As glm's product, leaving out the terms with the inverse bind's bottom-row zeros.
+    const glm::mat4& a = model[j];
+    const glm::mat4& b = inverse_bind[j];
+    glm::mat4& m = out_palette[j];
+    m[0] = a[0] * b[0][0] + a[1] * b[0][1] + a[2] * b[0][2];
+    m[1] = a[0] * b[1][0] + a[1] * b[1][1] + a[2] * b[1][2];
+    m[2] = a[0] * b[2][0] + a[1] * b[2][1] + a[2] * b[2][2];
+    m[3] = a[0] * b[3][0] + a[1] * b[3][1] + a[2] * b[3][2] + a[3];
+  }
+}
+
+bool is_affine(std::span<const glm::mat4> matrices) {
+  for (const glm::mat4& m : matrices) {
+    if (m[0][3] != 0.0f || m[1][3] != 0.0f || m[2][3] != 0.0f || m[3][3] != 1.0f) return false;
+  }
+  return true;
 }
 
 }  // namespace gk

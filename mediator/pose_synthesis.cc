@@ -129,8 +129,16 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     s.trans.resize(2 * kMaxBlendLayers * J);
     return s;
   });
-  first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
-  first_spine_joint_ = skeleton_.spine_chain.empty() ? num_joints_ : skeleton_.spine_chain.front();
+  subtree_end_ = subtree_ends(skeleton_);
+  for (Side side : {Side::kLeft, Side::kRight}) {
+    const int hip = skeleton_.hip(side), knee = skeleton_.knee(side);
+    JointRange& r = leg_range_[static_cast<int>(side)];
+    r = subtree(hip);
+    if (knee >= 0 && (knee < r.from || knee >= r.to)) {  // a knee outside its hip's subtree
+      r = {std::max(0, std::min(hip, knee)), num_joints_};
+    }
+  }
+  affine_inverse_bind_ = is_affine(inverse_bind_);
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -145,13 +153,32 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
   });
 }
 
-void PoseSynthesizer::fk_from(int slot, int first, const glm::mat4& root) {
-  const size_t base = static_cast<size_t>(slot) * num_joints_;
-  for (int j = std::max(first, 0); j < num_joints_; ++j) {
-    glm::mat4 local = glm::mat4_cast(local_rot_[base + j]);
-    local[3] = glm::vec4(local_trans_[base + j], 1.0f);
-    const int parent = skeleton_.parents[j];
-    world_[base + j] = (parent < 0 ? root : world_[base + parent]) * local;
+void PoseSynthesizer::fk(int slot, int from, int to, const glm::mat4& root) {
+  const size_t J = num_joints_;
+  const size_t base = static_cast<size_t>(slot) * J;
+  LocalToModelJob{&skeleton_,
+                  {local_rot_.data() + base, J},
+                  {local_trans_.data() + base, J},
+                  root,
+                  {world_.data() + base, J},
+                  from,
+                  to}
+      .run();
+}
+
+PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
+  if (joint < 0 || joint >= num_joints_) return {};
+  return {joint, subtree_end_[joint]};
+}
+
+void PoseSynthesizer::fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root) {
+  if (a.from >= a.to || (b.from < b.to && b.from < a.from)) std::swap(a, b);
+  if (a.from >= a.to) return;
+  if (b.from >= b.to || b.from >= a.to) {  // disjoint: one after the other
+    fk(slot, a.from, a.to, root);
+    if (b.from < b.to) fk(slot, b.from, b.to, root);
+  } else {
+    fk(slot, a.from, std::max(a.to, b.to), root);
   }
 }
 
@@ -200,7 +227,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool apm = P.mode == MediatorMode::kApm;
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
-  fk_from(slot, 0, root);
+  fk(slot, 0, num_joints_, root);
   if (apm) twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   if (apm && P.foot_locking) lock_feet(pl, P, slot, root, dt);
 
@@ -212,11 +239,13 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
-  if (has_prev_[slot]) {
+  if (has_prev_[slot] && J > 1) {
+    // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
+    float d_min = 1.0f;
     for (size_t j = 1; j < J; ++j) {  // joint 0 carries the root facing, not a local bend
-      const float d = std::abs(glm::dot(local_rot_[base + j], prev_local_rot_[base + j]));
-      change = std::max(change, 2.0f * std::acos(std::min(1.0f, d)));
+      d_min = std::min(d_min, std::abs(glm::dot(local_rot_[base + j], prev_local_rot_[base + j])));
     }
+    change = 2.0f * std::acos(d_min);
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -234,7 +263,9 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   has_prev_[slot] = 1;
   if (make_palettes_) {
-    SkinningPaletteJob{{world_.data() + base, J}, inverse_bind_, {palette_.data() + base, J}}.run();
+    SkinningPaletteJob{{world_.data() + base, J}, inverse_bind_, {palette_.data() + base, J},
+                       affine_inverse_bind_}
+        .run();
   }
 }
 
@@ -260,7 +291,7 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
     const glm::quat q = rotation_of(world_[base + j]);
     local_rot_[base + j] = glm::normalize(local_rot_[base + j] * (glm::inverse(q) * r * q));
   }
-  fk_from(slot, first_spine_joint_, root);
+  fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
 }
 
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
@@ -427,7 +458,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     local_rot_[base + hip] = glm::normalize(local_rot_[base + hip] * c_hip);
     local_rot_[base + knee] = glm::normalize(local_rot_[base + knee] * c_knee);
   }
-  fk_from(slot, first_leg_joint_, placed);
+  fk_ranges(slot, use_ik[0] ? leg_range_[0] : JointRange{}, use_ik[1] ? leg_range_[1] : JointRange{},
+            placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet.
   for (int side = 0; side < 2; ++side) {
     const Side sd = static_cast<Side>(side);
@@ -437,7 +469,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
     local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
   }
-  fk_from(slot, std::min(skeleton_.ankle(Side::kLeft), skeleton_.ankle(Side::kRight)), placed);
+  fk_ranges(slot, subtree(skeleton_.ankle(Side::kLeft)), subtree(skeleton_.ankle(Side::kRight)),
+            placed);
 }
 
 }  // namespace gk

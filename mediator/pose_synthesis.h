@@ -70,7 +70,15 @@ class PoseSynthesizer {
   struct Scratch;
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s);
-  void fk_from(int slot, int first_joint, const glm::mat4& root);
+  // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
+  void fk(int slot, int from, int to, const glm::mat4& root);
+  // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
+  struct JointRange {
+    int from = 0, to = 0;
+  };
+  JointRange subtree(int joint) const;
+  // Forward kinematics of two ranges (overlapping ones in one pass).
+  void fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root);
   void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
   void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
                  float dt);
@@ -96,8 +104,9 @@ class PoseSynthesizer {
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
-  int first_leg_joint_ = 0;
-  int first_spine_joint_ = 0;
+  std::vector<int> subtree_end_;  // subtree_ends(skeleton_)
+  JointRange leg_range_[2];       // per side, what moves when leg IK turns the hip and the knee
+  bool affine_inverse_bind_ = false;
 };
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
