@@ -99,12 +99,28 @@ struct SkinningPaletteJob {
   std::span<const glm::mat4> inverse_bind;
   std::span<glm::mat4> out_palette;
   bool affine_inverse_bind = false;
+  // With affine_inverse_bind: write the palette past the caches (non-temporal stores), for a
+  // crowd's palettes, far more than the caches hold and read only later by the upload.
+  bool stream_out = false;
   bool validate() const;
   void run() const;
 };
 
 // True when every matrix's bottom row is exactly 0 0 0 1.
 bool is_affine(std::span<const glm::mat4> matrices);
+
+// Asks the caches for the lines of [p, p + bytes) ahead of use (a hint; no effect on results).
+inline void prefetch_bytes(const void* p, size_t bytes, bool for_write = false) {
+  const char* c = static_cast<const char*>(p);
+  for (size_t off = 0; off < bytes; off += 64) {
+    if (for_write) {
+      __builtin_prefetch(c + off, 1);
+    } else {
+      __builtin_prefetch(c + off, 0);
+    }
+  }
+  if (bytes > 0) __builtin_prefetch(c + bytes - 1, for_write ? 1 : 0);
+}
 
 // Small helpers used by several jobs and by analysis.
 inline glm::vec3 translation_of(const glm::mat4& m) { return glm::vec3(m[3]); }

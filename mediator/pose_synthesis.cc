@@ -81,9 +81,14 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
 
 }  // namespace
 
-float joint_heading(const glm::mat4& world, const glm::quat& rest_model_rot_inv) {
-  const glm::vec3 f = rotation_of(world) * (rest_model_rot_inv * glm::vec3(0, 0, 1));
-  return std::atan2(f.x, f.z);
+float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward) {
+  // The world matrix's rotation applied to the rest-relative forward (no quaternion needed: the
+  // joints' world matrices are rotations, and the heading ignores a length anyway).
+  const float x = world[0].x * rest_forward.x + world[1].x * rest_forward.y +
+                  world[2].x * rest_forward.z;
+  const float z = world[0].z * rest_forward.x + world[1].z * rest_forward.y +
+                  world[2].z * rest_forward.z;
+  return std::atan2(x, z);
 }
 
 PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capacity,
@@ -97,8 +102,10 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   LocalToModelJob{&skeleton_, skeleton_.rest_rotations, skeleton_.rest_translations,
                   glm::mat4(1.0f), rest}
       .run();
-  rest_model_rot_inv_.resize(J);
-  for (size_t j = 0; j < J; ++j) rest_model_rot_inv_[j] = glm::inverse(rotation_of(rest[j]));
+  rest_forward_.resize(J);
+  for (size_t j = 0; j < J; ++j) {
+    rest_forward_[j] = glm::inverse(rotation_of(rest[j])) * glm::vec3(0, 0, 1);
+  }
   if (library.mesh && library.mesh->inverse_bind.size() == J) {
     inverse_bind_ = library.mesh->inverse_bind;
   } else {
@@ -192,6 +199,13 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     drop_rate_[slot] = 0.0f;
   }
 
+  // This slot's pose arrays, most likely out of the caches since its last frame: fetched while
+  // the clips are sampled.
+  prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
+  prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
+  prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
+  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
+
   // Sample and blend the planned layers.
   PoseLayer layers[2 * kMaxBlendLayers];
   int num_layers = 0;
@@ -234,8 +248,8 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
-    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_model_rot_inv_[hips]);
-    upper_heading_[slot] = joint_heading(world_[base + chest], rest_model_rot_inv_[chest]);
+    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+    upper_heading_[slot] = joint_heading(world_[base + chest], rest_forward_[chest]);
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
@@ -264,7 +278,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   has_prev_[slot] = 1;
   if (make_palettes_) {
     SkinningPaletteJob{{world_.data() + base, J}, inverse_bind_, {palette_.data() + base, J},
-                       affine_inverse_bind_}
+                       affine_inverse_bind_, /*stream_out=*/true}
         .run();
   }
 }
@@ -274,8 +288,8 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (chain.empty() || hips < 0 || chest < 0) return;
   const size_t base = static_cast<size_t>(slot) * num_joints_;
-  const float pelvis = joint_heading(world_[base + hips], rest_model_rot_inv_[hips]);
-  const float chest_now = joint_heading(world_[base + chest], rest_model_rot_inv_[chest]);
+  const float pelvis = joint_heading(world_[base + hips], rest_forward_[hips]);
+  const float chest_now = joint_heading(world_[base + chest], rest_forward_[chest]);
   // The chest should face upper_yaw, but never further than the limit from the pelvis.
   // Unwrapped against last frame's torsion: theta passing behind the back must not flip the twist
   // from one limit to the other in a single frame.
@@ -285,11 +299,15 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   const float twist = wanted - wrap_pi(chest_now - pelvis);
   const float per_joint = twist / static_cast<float>(chain.size());
   // A world-space rotation R at joint j becomes the local correction inv(Q_j) R Q_j; rotations
-  // about the same (vertical) axis commute, so every correction uses the un-twisted Q_j.
-  const glm::quat r = glm::angleAxis(per_joint, glm::vec3(0, 1, 0));
+  // about the same (vertical) axis commute, so every correction uses the un-twisted Q_j. R turns
+  // about world up, so inv(Q_j) R Q_j turns by the same angle about up seen from the joint:
+  // inv(Q_j) * up, the world matrix's row y.
+  const float c = std::cos(0.5f * per_joint), sn = std::sin(0.5f * per_joint);
   for (int16_t j : chain) {
-    const glm::quat q = rotation_of(world_[base + j]);
-    local_rot_[base + j] = glm::normalize(local_rot_[base + j] * (glm::inverse(q) * r * q));
+    const glm::mat4& m = world_[base + j];
+    const glm::vec3 up = glm::normalize(glm::vec3(m[0].y, m[1].y, m[2].y));
+    const glm::quat corr(c, sn * up.x, sn * up.y, sn * up.z);
+    local_rot_[base + j] = glm::normalize(local_rot_[base + j] * corr);
   }
   fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
 }

@@ -87,8 +87,7 @@ class PoseSynthesizer {
   const Skeleton& skeleton_;
   int num_joints_;
   bool make_palettes_;
-  std::vector<glm::quat>
-      rest_model_rot_inv_;  // inverse rest model rotations: rest-relative forward
+  std::vector<glm::vec3> rest_forward_;  // per joint, +z of the rest pose in the joint's frame
   std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::quat> local_rot_;
   std::vector<glm::vec3> local_trans_;
@@ -110,7 +109,7 @@ class PoseSynthesizer {
 };
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
-// +z): heading [rad].
-float joint_heading(const glm::mat4& world, const glm::quat& rest_model_rot_inv);
+// +z; rest_forward is that +z in the joint's own frame): heading [rad].
+float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward);
 
 }  // namespace gk

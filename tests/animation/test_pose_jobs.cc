@@ -94,6 +94,75 @@ TEST(BlendPosesJob, WeightedMeanAndHemisphere) {
   EXPECT_LT(deg, 35.0f);
 }
 
+// Random unit quaternions, about half of them in the far hemisphere of `near` (the same rotation
+// with the other sign), so the shortest-arc sign flips are exercised.
+std::vector<glm::quat> random_quats(int n, std::mt19937& rng, const std::vector<glm::quat>* near) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::quat> q(n);
+  for (int i = 0; i < n; ++i) {
+    q[i] = glm::normalize(glm::quat(u(rng), u(rng), u(rng), u(rng)));
+    if (near && glm::dot(q[i], (*near)[i]) > 0.0f && (i % 2)) q[i] = -q[i];
+  }
+  return q;
+}
+
+// Many joints (four at a time and a remainder): each one as the single-joint formula has it.
+TEST(SampleClipJob, EveryJointIsTheShortestArcNlerpOfItsFrames) {
+  const int n = 11;
+  std::mt19937 rng(9);
+  Clip c;
+  c.name = "many";
+  c.fps = 10.0f;
+  c.num_frames = 2;
+  c.num_joints = n;
+  const std::vector<glm::quat> f0 = random_quats(n, rng, nullptr);
+  const std::vector<glm::quat> f1 = random_quats(n, rng, &f0);
+  c.rotations = f0;
+  c.rotations.insert(c.rotations.end(), f1.begin(), f1.end());
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 2 * n; ++i) c.translations.push_back(glm::vec3(u(rng), u(rng), u(rng)));
+  std::vector<glm::quat> r(n);
+  std::vector<glm::vec3> t(n);
+  const float w = 0.3f;
+  SampleClipJob job{&c, w / c.fps, r, t};
+  ASSERT_TRUE(job.validate());
+  job.run();
+  for (int j = 0; j < n; ++j) {
+    const glm::quat b = glm::dot(f0[j], f1[j]) < 0.0f ? -f1[j] : f1[j];
+    const glm::quat want = glm::normalize(f0[j] * (1.0f - w) + b * w);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(r[j][k], want[k], 1e-6f) << "joint " << j;
+    const glm::vec3 want_t = glm::mix(c.translations[j], c.translations[n + j], w);
+    EXPECT_NEAR(glm::length(t[j] - want_t), 0.0f, 1e-6f) << "joint " << j;
+  }
+}
+
+TEST(BlendPosesJob, TwoLayersOfManyJointsEachAsTheFormula) {
+  const int n = 10;
+  std::mt19937 rng(4);
+  const std::vector<glm::quat> a = random_quats(n, rng, nullptr);
+  const std::vector<glm::quat> b = random_quats(n, rng, &a);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::vec3> ta(n), tb(n);
+  for (int i = 0; i < n; ++i) {
+    ta[i] = glm::vec3(u(rng), u(rng), u(rng));
+    tb[i] = glm::vec3(u(rng), u(rng), u(rng));
+  }
+  // A weightless layer between them is skipped.
+  PoseLayer layers[3] = {{a, ta, 2.0f}, {b, tb, 0.0f}, {b, tb, 1.0f}};
+  std::vector<glm::quat> r(n);
+  std::vector<glm::vec3> t(n);
+  BlendPosesJob job{layers, r, t};
+  ASSERT_TRUE(job.validate());
+  job.run();
+  for (int j = 0; j < n; ++j) {
+    const glm::quat bj = glm::dot(a[j], b[j]) < 0.0f ? -b[j] : b[j];
+    const glm::quat want = glm::normalize(a[j] * (2.0f / 3.0f) + bj * (1.0f / 3.0f));
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(r[j][k], want[k], 1e-6f) << "joint " << j;
+    EXPECT_NEAR(glm::length(t[j] - (ta[j] * (2.0f / 3.0f) + tb[j] * (1.0f / 3.0f))), 0.0f, 1e-6f)
+        << "joint " << j;
+  }
+}
+
 TEST(BlendPosesJob, OneWeightedLayerIsCopied) {
   const glm::quat a = glm::angleAxis(glm::radians(20.0f), glm::vec3(0, 0, 1));
   const glm::quat b = glm::angleAxis(glm::radians(70.0f), glm::vec3(1, 0, 0));
@@ -359,6 +428,9 @@ TEST(SkinningPaletteJob, AffineProductEqualsTheFullOne) {
   SkinningPaletteJob{m, inv, full, false}.run();
   SkinningPaletteJob{m, inv, affine, true}.run();
   for (int i = 0; i < n; ++i) EXPECT_TRUE(same(full[i], affine[i])) << s->names[i];
+  std::vector<glm::mat4> streamed(n);
+  SkinningPaletteJob{m, inv, streamed, true, true}.run();
+  for (int i = 0; i < n; ++i) EXPECT_TRUE(same(full[i], streamed[i])) << s->names[i];
   inv[3][1][3] = 1e-7f;  // not affine any more
   EXPECT_FALSE(is_affine(inv));
 }
