@@ -380,9 +380,9 @@ void SkinningPaletteJob::run() const {
                    a2 = _mm_loadu_ps(&a[2].x), a3 = _mm_loadu_ps(&a[3].x);
       float* m = &out_palette[j][0].x;
       for (int c = 0; c < 4; ++c) {
-        __m128 col = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(b[c][0])),
-                                           _mm_mul_ps(a1, _mm_set1_ps(b[c][1]))),
-                                _mm_mul_ps(a2, _mm_set1_ps(b[c][2])));
+        __m128 col = _mm_add_ps(
+            _mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(b[c][0])), _mm_mul_ps(a1, _mm_set1_ps(b[c][1]))),
+            _mm_mul_ps(a2, _mm_set1_ps(b[c][2])));
         if (c == 3) col = _mm_add_ps(col, a3);
         _mm_stream_ps(m + 4 * c, col);
       }

@@ -84,10 +84,10 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
 float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward) {
   // The world matrix's rotation applied to the rest-relative forward (no quaternion needed: the
   // joints' world matrices are rotations, and the heading ignores a length anyway).
-  const float x = world[0].x * rest_forward.x + world[1].x * rest_forward.y +
-                  world[2].x * rest_forward.z;
-  const float z = world[0].z * rest_forward.x + world[1].z * rest_forward.y +
-                  world[2].z * rest_forward.z;
+  const float x =
+      world[0].x * rest_forward.x + world[1].x * rest_forward.y + world[2].x * rest_forward.z;
+  const float z =
+      world[0].z * rest_forward.x + world[1].z * rest_forward.y + world[2].z * rest_forward.z;
   return std::atan2(x, z);
 }
 
@@ -146,6 +146,9 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     }
   }
   affine_inverse_bind_ = is_affine(inverse_bind_);
+  // A crowd's palettes far larger than the caches are written past them (read only by the
+  // upload, after the whole crowd is posed); a small crowd's stay cached for it.
+  stream_palettes_ = palette_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -163,14 +166,15 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
 void PoseSynthesizer::fk(int slot, int from, int to, const glm::mat4& root) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
-  LocalToModelJob{&skeleton_,
-                  {local_rot_.data() + base, J},
-                  {local_trans_.data() + base, J},
-                  root,
-                  {world_.data() + base, J},
-                  from,
-                  to}
-      .run();
+  LocalToModelJob job;
+  job.skeleton = &skeleton_;
+  job.rotations = {local_rot_.data() + base, J};
+  job.translations = {local_trans_.data() + base, J};
+  job.root_transform = root;
+  job.out_model = {world_.data() + base, J};
+  job.from = from;
+  job.to = to;
+  job.run();
 }
 
 PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
@@ -277,9 +281,13 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   has_prev_[slot] = 1;
   if (make_palettes_) {
-    SkinningPaletteJob{{world_.data() + base, J}, inverse_bind_, {palette_.data() + base, J},
-                       affine_inverse_bind_, /*stream_out=*/true}
-        .run();
+    SkinningPaletteJob job;
+    job.model = {world_.data() + base, J};
+    job.inverse_bind = inverse_bind_;
+    job.out_palette = {palette_.data() + base, J};
+    job.affine_inverse_bind = affine_inverse_bind_;
+    job.stream_out = stream_palettes_;
+    job.run();
   }
 }
 
@@ -476,8 +484,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     local_rot_[base + hip] = glm::normalize(local_rot_[base + hip] * c_hip);
     local_rot_[base + knee] = glm::normalize(local_rot_[base + knee] * c_knee);
   }
-  fk_ranges(slot, use_ik[0] ? leg_range_[0] : JointRange{}, use_ik[1] ? leg_range_[1] : JointRange{},
-            placed);
+  fk_ranges(slot, use_ik[0] ? leg_range_[0] : JointRange{},
+            use_ik[1] ? leg_range_[1] : JointRange{}, placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet.
   for (int side = 0; side < 2; ++side) {
     const Side sd = static_cast<Side>(side);

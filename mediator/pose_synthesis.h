@@ -106,6 +106,7 @@ class PoseSynthesizer {
   std::vector<int> subtree_end_;  // subtree_ends(skeleton_)
   JointRange leg_range_[2];       // per side, what moves when leg IK turns the hip and the knee
   bool affine_inverse_bind_ = false;
+  bool stream_palettes_ = false;
 };
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces

@@ -211,9 +211,8 @@ TEST(LocalToModelJob, EqualsThePlainMatrixProduct) {
   std::vector<glm::quat> r;
   std::vector<glm::vec3> t;
   random_pose(*s, rng, &r, &t);
-  const glm::mat4 root =
-      glm::translate(glm::mat4(1), glm::vec3(3, 0.1f, -2)) *
-      glm::mat4_cast(glm::angleAxis(0.7f, glm::vec3(0, 1, 0)));
+  const glm::mat4 root = glm::translate(glm::mat4(1), glm::vec3(3, 0.1f, -2)) *
+                         glm::mat4_cast(glm::angleAxis(0.7f, glm::vec3(0, 1, 0)));
   std::vector<glm::mat4> m(s->num_joints());
   LocalToModelJob{s.get(), r, t, root, m}.run();
   for (int j = 0; j < s->num_joints(); ++j) {
