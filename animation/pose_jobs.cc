@@ -2,6 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <xmmintrin.h>
+#endif
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtx/quaternion.hpp>
@@ -18,6 +24,68 @@ glm::quat nlerp_shortest(const glm::quat& a, const glm::quat& b, float t) {
 }
 
 float clamp_unit(float x) { return std::clamp(x, -1.0f, 1.0f); }
+
+#if defined(__SSE2__)
+// Four joints at once, one per SIMD lane (quaternions transposed to x, y, z, w rows). Every lane
+// does the scalar code's operations in its order (glm's dot pairs (w, x) and (y, z); sqrt and
+// division are correctly rounded either way), so the results are the same bits.
+struct Quat4 {
+  __m128 x, y, z, w;
+};
+
+Quat4 load4(const glm::quat* q) {
+  Quat4 r{_mm_loadu_ps(&q[0].x), _mm_loadu_ps(&q[1].x), _mm_loadu_ps(&q[2].x),
+          _mm_loadu_ps(&q[3].x)};
+  _MM_TRANSPOSE4_PS(r.x, r.y, r.z, r.w);
+  return r;
+}
+
+void store4(Quat4 r, glm::quat* q) {
+  _MM_TRANSPOSE4_PS(r.x, r.y, r.z, r.w);
+  _mm_storeu_ps(&q[0].x, r.x);
+  _mm_storeu_ps(&q[1].x, r.y);
+  _mm_storeu_ps(&q[2].x, r.z);
+  _mm_storeu_ps(&q[3].x, r.w);
+}
+
+__m128 dot4(const Quat4& a, const Quat4& b) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(a.w, b.w), _mm_mul_ps(a.x, b.x)),
+                    _mm_add_ps(_mm_mul_ps(a.y, b.y), _mm_mul_ps(a.z, b.z)));
+}
+
+// a * wa + b * wb, b negated in the lanes where `negate` is set (sign flip, exact).
+Quat4 weighted_sum4(const Quat4& a, __m128 wa, const Quat4& b, __m128 wb, __m128 negate) {
+  const __m128 sign = _mm_and_ps(negate, _mm_set1_ps(-0.0f));
+  auto lane = [&](__m128 pa, __m128 pb) {
+    return _mm_add_ps(_mm_mul_ps(pa, wa), _mm_mul_ps(_mm_xor_ps(pb, sign), wb));
+  };
+  return {lane(a.x, b.x), lane(a.y, b.y), lane(a.z, b.z), lane(a.w, b.w)};
+}
+
+// glm::normalize: q / |q|, identity where |q| <= 0.
+Quat4 normalize4(const Quat4& q) {
+  const __m128 len = _mm_sqrt_ps(dot4(q, q));
+  const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), len);
+  const __m128 bad = _mm_cmple_ps(len, _mm_setzero_ps());
+  auto keep = [&](__m128 v) { return _mm_andnot_ps(bad, _mm_mul_ps(v, inv)); };
+  return {keep(q.x), keep(q.y), keep(q.z),
+          _mm_or_ps(keep(q.w), _mm_and_ps(bad, _mm_set1_ps(1.0f)))};
+}
+#endif
+
+// out[i] = a[i] * wa + b[i] * wb over n floats (glm::mix with wa = 1 - t, wb = t, element by
+// element; also a two-layer weighted mean).
+void weighted_floats(const float* a, float wa, const float* b, float wb, size_t n, float* out) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  const __m128 wa4 = _mm_set1_ps(wa), wb4 = _mm_set1_ps(wb);
+  for (; i + 4 <= n; i += 4) {
+    _mm_storeu_ps(out + i, _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(a + i), wa4),
+                                      _mm_mul_ps(_mm_loadu_ps(b + i), wb4)));
+  }
+#endif
+  for (; i < n; ++i) out[i] = a[i] * wa + b[i] * wb;
+}
 
 // Rotation taking unit vector `from` onto unit vector `to` (identity when either is degenerate).
 glm::quat rotation_between(glm::vec3 from, glm::vec3 to) {
@@ -87,10 +155,24 @@ void SampleClipJob::run() const {
   const glm::quat* r1 = clip->frame_rotations(i1);
   const glm::vec3* p0 = clip->frame_translations(i0);
   const glm::vec3* p1 = clip->frame_translations(i1);
-  for (int j = 0; j < n; ++j) {
-    out_rotations[j] = nlerp_shortest(r0[j], r1[j], t);
-    out_translations[j] = glm::mix(p0[j], p1[j], t);
+  // The two frames are somewhere in the clip, likely out of the caches: ask for all their lines
+  // at once rather than one stream after the other.
+  prefetch_bytes(r0, n * sizeof(glm::quat));
+  prefetch_bytes(r1, n * sizeof(glm::quat));
+  prefetch_bytes(p0, n * sizeof(glm::vec3));
+  prefetch_bytes(p1, n * sizeof(glm::vec3));
+  int j = 0;
+#if defined(__SSE2__)
+  const __m128 s4 = _mm_set1_ps(1.0f - t), t4 = _mm_set1_ps(t);
+  for (; j + 4 <= n; j += 4) {
+    const Quat4 a = load4(r0 + j), b = load4(r1 + j);
+    const __m128 negate = _mm_cmplt_ps(dot4(a, b), _mm_setzero_ps());
+    store4(normalize4(weighted_sum4(a, s4, b, t4, negate)), out_rotations.data() + j);
   }
+#endif
+  for (; j < n; ++j) out_rotations[j] = nlerp_shortest(r0[j], r1[j], t);
+  weighted_floats(reinterpret_cast<const float*>(p0), 1.0f - t, reinterpret_cast<const float*>(p1),
+                  t, 3 * static_cast<size_t>(n), reinterpret_cast<float*>(out_translations.data()));
   if (clip->loops && i1 < i0 && frames > 1) {
     // Across the wrap the root keeps travelling: frame 0 of the next loop lies one loop's
     // horizontal root displacement ahead (estimated from the clip's mean root velocity).
@@ -116,21 +198,45 @@ bool BlendPosesJob::validate() const {
 
 void BlendPosesJob::run() const {
   float total = 0.0f;
-  int first = -1;
+  int first = -1, weighted = 0;
   for (size_t k = 0; k < layers.size(); ++k) {
     if (layers[k].weight > 0.0f) {
       total += layers[k].weight;
       if (first < 0) first = static_cast<int>(k);
+      ++weighted;
     }
   }
   const size_t n = out_rotations.size();
-  if (first < 0) {  // nothing weighted: fall back to the first layer unchanged
-    std::copy_n(layers[0].rotations.begin(), n, out_rotations.begin());
-    std::copy_n(layers[0].translations.begin(), n, out_translations.begin());
+  if (weighted <= 1) {  // one layer is the blend (unit rotations stay); none: the first unchanged
+    const PoseLayer& only = layers[std::max(first, 0)];
+    std::copy_n(only.rotations.begin(), n, out_rotations.begin());
+    std::copy_n(only.translations.begin(), n, out_translations.begin());
     return;
   }
   const float inv_total = 1.0f / total;
-  for (size_t j = 0; j < n; ++j) {
+  size_t j = 0;
+#if defined(__SSE2__)
+  if (weighted == 2) {
+    // Two layers (the usual blend), four joints at a time: the loop below's operations in its
+    // order (0 + w a is w a, but for the sign of a zero), so the same numbers.
+    int second = first + 1;
+    while (layers[second].weight <= 0.0f) ++second;
+    const PoseLayer& la = layers[first];
+    const PoseLayer& lb = layers[second];
+    const float wa = la.weight * inv_total, wb = lb.weight * inv_total;
+    const __m128 wa4 = _mm_set1_ps(wa), wb4 = _mm_set1_ps(wb);
+    for (; j + 4 <= n; j += 4) {
+      const Quat4 a = load4(la.rotations.data() + j), b = load4(lb.rotations.data() + j);
+      // The first layer is its own reference: dot(a, a) >= 0 keeps its weight positive.
+      const __m128 negate = _mm_cmplt_ps(dot4(a, b), _mm_setzero_ps());
+      store4(normalize4(weighted_sum4(a, wa4, b, wb4, negate)), out_rotations.data() + j);
+    }
+    weighted_floats(reinterpret_cast<const float*>(la.translations.data()), wa,
+                    reinterpret_cast<const float*>(lb.translations.data()), wb, 3 * n,
+                    reinterpret_cast<float*>(out_translations.data()));
+  }
+#endif
+  for (; j < n; ++j) {
     const glm::quat ref = layers[first].rotations[j];
     glm::quat q(0, 0, 0, 0);
     glm::vec3 p(0.0f);
@@ -148,17 +254,27 @@ void BlendPosesJob::run() const {
 
 bool LocalToModelJob::validate() const {
   if (!skeleton) return false;
-  const size_t n = static_cast<size_t>(skeleton->num_joints());
-  return rotations.size() >= n && translations.size() >= n && out_model.size() >= n;
+  const int n = skeleton->num_joints();
+  const size_t un = static_cast<size_t>(n);
+  return rotations.size() >= un && translations.size() >= un && out_model.size() >= un &&
+         from >= 0 && from <= n && (to < 0 || (to >= from && to <= n));
 }
 
 void LocalToModelJob::run() const {
   const int n = skeleton->num_joints();
-  for (int j = 0; j < n; ++j) {
-    glm::mat4 local = glm::mat4_cast(rotations[j]);
-    local[3] = glm::vec4(translations[j], 1.0f);
+  const int end = to < 0 ? n : std::min(to, n);
+  for (int j = std::max(from, 0); j < end; ++j) {
     const int parent = skeleton->parents[j];
-    out_model[j] = (parent < 0 ? root_transform : out_model[parent]) * local;
+    const glm::mat4& p = parent < 0 ? root_transform : out_model[parent];
+    // p * [R t; 0 1], leaving out the products with the local matrix's zeros (the sums keep glm's
+    // order, so the result is glm's p * local to the bit).
+    const glm::mat3 r = glm::mat3_cast(rotations[j]);
+    const glm::vec3& t = translations[j];
+    glm::mat4& m = out_model[j];
+    m[0] = p[0] * r[0][0] + p[1] * r[0][1] + p[2] * r[0][2];
+    m[1] = p[0] * r[1][0] + p[1] * r[1][1] + p[2] * r[1][2];
+    m[2] = p[0] * r[2][0] + p[1] * r[2][1] + p[2] * r[2][2];
+    m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
   }
 }
 
@@ -251,7 +367,47 @@ bool SkinningPaletteJob::validate() const {
 }
 
 void SkinningPaletteJob::run() const {
-  for (size_t j = 0; j < model.size(); ++j) out_palette[j] = model[j] * inverse_bind[j];
+  if (!affine_inverse_bind) {
+    for (size_t j = 0; j < model.size(); ++j) out_palette[j] = model[j] * inverse_bind[j];
+    return;
+  }
+#if defined(__SSE2__)
+  if (stream_out && reinterpret_cast<uintptr_t>(out_palette.data()) % 16 == 0) {
+    for (size_t j = 0; j < model.size(); ++j) {
+      const glm::mat4& a = model[j];
+      const glm::mat4& b = inverse_bind[j];
+      const __m128 a0 = _mm_loadu_ps(&a[0].x), a1 = _mm_loadu_ps(&a[1].x),
+                   a2 = _mm_loadu_ps(&a[2].x), a3 = _mm_loadu_ps(&a[3].x);
+      float* m = &out_palette[j][0].x;
+      for (int c = 0; c < 4; ++c) {
+        __m128 col = _mm_add_ps(
+            _mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(b[c][0])), _mm_mul_ps(a1, _mm_set1_ps(b[c][1]))),
+            _mm_mul_ps(a2, _mm_set1_ps(b[c][2])));
+        if (c == 3) col = _mm_add_ps(col, a3);
+        _mm_stream_ps(m + 4 * c, col);
+      }
+    }
+    _mm_sfence();  // the streamed stores are ordered before whatever tells a reader they are done
+    return;
+  }
+#endif
+  for (size_t j = 0; j < model.size(); ++j) {
+    // As glm's product, leaving out the terms with the inverse bind's bottom-row zeros.
+    const glm::mat4& a = model[j];
+    const glm::mat4& b = inverse_bind[j];
+    glm::mat4& m = out_palette[j];
+    m[0] = a[0] * b[0][0] + a[1] * b[0][1] + a[2] * b[0][2];
+    m[1] = a[0] * b[1][0] + a[1] * b[1][1] + a[2] * b[1][2];
+    m[2] = a[0] * b[2][0] + a[1] * b[2][1] + a[2] * b[2][2];
+    m[3] = a[0] * b[3][0] + a[1] * b[3][1] + a[2] * b[3][2] + a[3];
+  }
+}
+
+bool is_affine(std::span<const glm::mat4> matrices) {
+  for (const glm::mat4& m : matrices) {
+    if (m[0][3] != 0.0f || m[1][3] != 0.0f || m[2][3] != 0.0f || m[3][3] != 1.0f) return false;
+  }
+  return true;
 }
 
 }  // namespace gk

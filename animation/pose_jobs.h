@@ -37,7 +37,8 @@ struct PoseLayer {
 };
 
 // Weighted blend of N local poses: translations by weighted mean, rotations by weighted nlerp with
-// every quaternion brought into the hemisphere of the first layer's.
+// every quaternion brought into the hemisphere of the first layer's. A single weighted layer is
+// copied as it is (its rotations are taken to be unit quaternions, as a sampled clip's are).
 struct BlendPosesJob {
   std::span<const PoseLayer> layers;
   std::span<glm::quat> out_rotations;
@@ -48,12 +49,17 @@ struct BlendPosesJob {
 
 // Local to model (forward kinematics): out_model[i] = out_model[parent] * T(t_i) * R(q_i), with
 // root_transform applied to the roots (world placement of the character).
+// By default every joint; [from, to) recomputes only those joints (ozz's from/to), for a partial
+// update after some local transforms changed: out_model of every parent outside the range must be
+// current. After joint j changed, [j, subtree_ends(skeleton)[j]) covers everything that moved.
 struct LocalToModelJob {
   const Skeleton* skeleton = nullptr;
   std::span<const glm::quat> rotations;
   std::span<const glm::vec3> translations;
   glm::mat4 root_transform = glm::mat4(1.0f);
   std::span<glm::mat4> out_model;
+  int from = 0;
+  int to = -1;  // < 0: to the last joint
   bool validate() const;
   void run() const;
 };
@@ -85,14 +91,36 @@ struct TwoBoneIKJob {
   void run() const;
 };
 
-// Skinning matrices: out[j] = model[j] * inverse_bind[j].
+// Skinning matrices: out[j] = model[j] * inverse_bind[j]. Affine inverse binds (bottom row
+// 0 0 0 1, as every rig's) take the cheaper affine product; affine_inverse_bind tells which
+// (is_affine(inverse_bind) once per rig; false always gives the full product).
 struct SkinningPaletteJob {
   std::span<const glm::mat4> model;
   std::span<const glm::mat4> inverse_bind;
   std::span<glm::mat4> out_palette;
+  bool affine_inverse_bind = false;
+  // With affine_inverse_bind: write the palette past the caches (non-temporal stores), for a
+  // crowd's palettes, far more than the caches hold and read only later by the upload.
+  bool stream_out = false;
   bool validate() const;
   void run() const;
 };
+
+// True when every matrix's bottom row is exactly 0 0 0 1.
+bool is_affine(std::span<const glm::mat4> matrices);
+
+// Asks the caches for the lines of [p, p + bytes) ahead of use (a hint; no effect on results).
+inline void prefetch_bytes(const void* p, size_t bytes, bool for_write = false) {
+  const char* c = static_cast<const char*>(p);
+  for (size_t off = 0; off < bytes; off += 64) {
+    if (for_write) {
+      __builtin_prefetch(c + off, 1);
+    } else {
+      __builtin_prefetch(c + off, 0);
+    }
+  }
+  if (bytes > 0) __builtin_prefetch(c + bytes - 1, for_write ? 1 : 0);
+}
 
 // Small helpers used by several jobs and by analysis.
 inline glm::vec3 translation_of(const glm::mat4& m) { return glm::vec3(m[3]); }

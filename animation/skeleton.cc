@@ -504,4 +504,25 @@ Status validate_skeleton(const Skeleton& s, const std::string& source_name) {
   return Status::Ok();
 }
 
+std::vector<int> subtree_ends(const Skeleton& s) {
+  const int n = s.num_joints();
+  std::vector<int> end(n, n);
+  for (int j = 0; j < n; ++j) {
+    if (s.parents[j] >= j || s.parents[j] < -1) return end;  // not parents-first: whole ranges
+  }
+  // Children after parents: one backward pass gathers each subtree's last joint and size.
+  std::vector<int> last(n), size(n, 1);
+  for (int j = 0; j < n; ++j) last[j] = j;
+  for (int j = n - 1; j > 0; --j) {
+    const int p = s.parents[j];
+    if (p < 0) continue;
+    last[p] = std::max(last[p], last[j]);
+    size[p] += size[j];
+  }
+  for (int j = 0; j < n; ++j) {
+    if (last[j] - j + 1 == size[j]) end[j] = last[j] + 1;  // contiguous: exactly the subtree
+  }
+  return end;
+}
+
 }  // namespace gk

@@ -110,4 +110,12 @@ Status apply_role_manifest_text(std::string_view json_text, const std::string& s
 // Validates structure (sizes agree, parents topological, finite numbers, unit quaternions).
 Status validate_skeleton(const Skeleton& skeleton, const std::string& source_name);
 
+// Subtree ranges, per joint j the end e of the joint range [j, e) that forward kinematics has to
+// recompute after j's local transform changed. Where j's descendants follow it contiguously (a
+// depth-first order: BVH files, the built-in rig) the range holds exactly j and its descendants;
+// otherwise (or with parents out of order) it runs to the last joint, which in a parents-first
+// order also covers them. Made once by the user (it is not kept in Skeleton, which loaders build
+// and edit joint by joint).
+std::vector<int> subtree_ends(const Skeleton& skeleton);
+
 }  // namespace gk

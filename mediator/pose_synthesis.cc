@@ -81,9 +81,14 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
 
 }  // namespace
 
-float joint_heading(const glm::mat4& world, const glm::quat& rest_model_rot_inv) {
-  const glm::vec3 f = rotation_of(world) * (rest_model_rot_inv * glm::vec3(0, 0, 1));
-  return std::atan2(f.x, f.z);
+float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward) {
+  // The world matrix's rotation applied to the rest-relative forward (no quaternion needed: the
+  // joints' world matrices are rotations, and the heading ignores a length anyway).
+  const float x =
+      world[0].x * rest_forward.x + world[1].x * rest_forward.y + world[2].x * rest_forward.z;
+  const float z =
+      world[0].z * rest_forward.x + world[1].z * rest_forward.y + world[2].z * rest_forward.z;
+  return std::atan2(x, z);
 }
 
 PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capacity,
@@ -97,8 +102,10 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   LocalToModelJob{&skeleton_, skeleton_.rest_rotations, skeleton_.rest_translations,
                   glm::mat4(1.0f), rest}
       .run();
-  rest_model_rot_inv_.resize(J);
-  for (size_t j = 0; j < J; ++j) rest_model_rot_inv_[j] = glm::inverse(rotation_of(rest[j]));
+  rest_forward_.resize(J);
+  for (size_t j = 0; j < J; ++j) {
+    rest_forward_[j] = glm::inverse(rotation_of(rest[j])) * glm::vec3(0, 0, 1);
+  }
   if (library.mesh && library.mesh->inverse_bind.size() == J) {
     inverse_bind_ = library.mesh->inverse_bind;
   } else {
@@ -130,8 +137,19 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     s.trans.resize(2 * kMaxBlendLayers * J);
     return s;
   });
-  first_leg_joint_ = std::min(skeleton_.hip(Side::kLeft), skeleton_.hip(Side::kRight));
-  first_spine_joint_ = skeleton_.spine_chain.empty() ? num_joints_ : skeleton_.spine_chain.front();
+  subtree_end_ = subtree_ends(skeleton_);
+  for (Side side : {Side::kLeft, Side::kRight}) {
+    const int hip = skeleton_.hip(side), knee = skeleton_.knee(side);
+    JointRange& r = leg_range_[static_cast<int>(side)];
+    r = subtree(hip);
+    if (knee >= 0 && (knee < r.from || knee >= r.to)) {  // a knee outside its hip's subtree
+      r = {std::max(0, std::min(hip, knee)), num_joints_};
+    }
+  }
+  affine_inverse_bind_ = is_affine(inverse_bind_);
+  // A crowd's palettes far larger than the caches are written past them (read only by the
+  // upload, after the whole crowd is posed); a small crowd's stay cached for it.
+  stream_palettes_ = palette_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -188,13 +206,33 @@ void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
   }
 }
 
-void PoseSynthesizer::fk_from(int slot, int first, const glm::mat4& root) {
-  const size_t base = static_cast<size_t>(slot) * num_joints_;
-  for (int j = std::max(first, 0); j < num_joints_; ++j) {
-    glm::mat4 local = glm::mat4_cast(local_rot_[base + j]);
-    local[3] = glm::vec4(local_trans_[base + j], 1.0f);
-    const int parent = skeleton_.parents[j];
-    world_[base + j] = (parent < 0 ? root : world_[base + parent]) * local;
+void PoseSynthesizer::fk(int slot, int from, int to, const glm::mat4& root) {
+  const size_t J = num_joints_;
+  const size_t base = static_cast<size_t>(slot) * J;
+  LocalToModelJob job;
+  job.skeleton = &skeleton_;
+  job.rotations = {local_rot_.data() + base, J};
+  job.translations = {local_trans_.data() + base, J};
+  job.root_transform = root;
+  job.out_model = {world_.data() + base, J};
+  job.from = from;
+  job.to = to;
+  job.run();
+}
+
+PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
+  if (joint < 0 || joint >= num_joints_) return {};
+  return {joint, subtree_end_[joint]};
+}
+
+void PoseSynthesizer::fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root) {
+  if (a.from >= a.to || (b.from < b.to && b.from < a.from)) std::swap(a, b);
+  if (a.from >= a.to) return;
+  if (b.from >= b.to || b.from >= a.to) {  // disjoint: one after the other
+    fk(slot, a.from, a.to, root);
+    if (b.from < b.to) fk(slot, b.from, b.to, root);
+  } else {
+    fk(slot, a.from, std::max(a.to, b.to), root);
   }
 }
 
@@ -207,6 +245,13 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     drop_[slot] = 0.0f;  // nothing of the slot's previous agent carries over
     drop_rate_[slot] = 0.0f;
   }
+
+  // This slot's pose arrays, most likely out of the caches since its last frame: fetched while
+  // the clips are sampled.
+  prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
+  prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
+  prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
+  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
 
   // Sample and blend the planned layers.
   PoseLayer layers[2 * kMaxBlendLayers];
@@ -245,7 +290,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   placed_xz_[slot] = pl.root_xz[slot];
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
-  fk_from(slot, 0, root);
+  fk(slot, 0, num_joints_, root);
   if (apm && detail != PoseDetail::kLight) {
     twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
@@ -254,16 +299,18 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
-    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_model_rot_inv_[hips]);
-    upper_heading_[slot] = joint_heading(world_[base + chest], rest_model_rot_inv_[chest]);
+    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+    upper_heading_[slot] = joint_heading(world_[base + chest], rest_forward_[chest]);
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
-  if (has_prev_[slot]) {
+  if (has_prev_[slot] && J > 1) {
+    // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
+    float d_min = 1.0f;
     for (size_t j = 1; j < J; ++j) {  // joint 0 carries the root facing, not a local bend
-      const float d = std::abs(glm::dot(local_rot_[base + j], prev_local_rot_[base + j]));
-      change = std::max(change, 2.0f * std::acos(std::min(1.0f, d)));
+      d_min = std::min(d_min, std::abs(glm::dot(local_rot_[base + j], prev_local_rot_[base + j])));
     }
+    change = 2.0f * std::acos(d_min);
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -285,7 +332,13 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   has_prev_[slot] = 1;
   if (make_palettes_) {
-    SkinningPaletteJob{{world_.data() + base, J}, inverse_bind_, {palette_.data() + base, J}}.run();
+    SkinningPaletteJob job;
+    job.model = {world_.data() + base, J};
+    job.inverse_bind = inverse_bind_;
+    job.out_palette = {palette_.data() + base, J};
+    job.affine_inverse_bind = affine_inverse_bind_;
+    job.stream_out = stream_palettes_;
+    job.run();
   }
 }
 
@@ -294,8 +347,8 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (chain.empty() || hips < 0 || chest < 0) return;
   const size_t base = static_cast<size_t>(slot) * num_joints_;
-  const float pelvis = joint_heading(world_[base + hips], rest_model_rot_inv_[hips]);
-  const float chest_now = joint_heading(world_[base + chest], rest_model_rot_inv_[chest]);
+  const float pelvis = joint_heading(world_[base + hips], rest_forward_[hips]);
+  const float chest_now = joint_heading(world_[base + chest], rest_forward_[chest]);
   // The chest should face upper_yaw, but never further than the limit from the pelvis.
   // Unwrapped against last frame's torsion: theta passing behind the back must not flip the twist
   // from one limit to the other in a single frame.
@@ -305,13 +358,17 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   const float twist = wanted - wrap_pi(chest_now - pelvis);
   const float per_joint = twist / static_cast<float>(chain.size());
   // A world-space rotation R at joint j becomes the local correction inv(Q_j) R Q_j; rotations
-  // about the same (vertical) axis commute, so every correction uses the un-twisted Q_j.
-  const glm::quat r = glm::angleAxis(per_joint, glm::vec3(0, 1, 0));
+  // about the same (vertical) axis commute, so every correction uses the un-twisted Q_j. R turns
+  // about world up, so inv(Q_j) R Q_j turns by the same angle about up seen from the joint:
+  // inv(Q_j) * up, the world matrix's row y.
+  const float c = std::cos(0.5f * per_joint), sn = std::sin(0.5f * per_joint);
   for (int16_t j : chain) {
-    const glm::quat q = rotation_of(world_[base + j]);
-    local_rot_[base + j] = glm::normalize(local_rot_[base + j] * (glm::inverse(q) * r * q));
+    const glm::mat4& m = world_[base + j];
+    const glm::vec3 up = glm::normalize(glm::vec3(m[0].y, m[1].y, m[2].y));
+    const glm::quat corr(c, sn * up.x, sn * up.y, sn * up.z);
+    local_rot_[base + j] = glm::normalize(local_rot_[base + j] * corr);
   }
-  fk_from(slot, first_spine_joint_, root);
+  fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
 }
 
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
@@ -481,7 +538,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     local_rot_[base + hip] = glm::normalize(local_rot_[base + hip] * c_hip);
     local_rot_[base + knee] = glm::normalize(local_rot_[base + knee] * c_knee);
   }
-  fk_from(slot, first_leg_joint_, placed);
+  fk_ranges(slot, use_ik[0] ? leg_range_[0] : JointRange{},
+            use_ik[1] ? leg_range_[1] : JointRange{}, placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet.
   for (int side = 0; side < 2; ++side) {
     const Side sd = static_cast<Side>(side);
@@ -491,7 +549,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
     local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
   }
-  fk_from(slot, std::min(skeleton_.ankle(Side::kLeft), skeleton_.ankle(Side::kRight)), placed);
+  fk_ranges(slot, subtree(skeleton_.ankle(Side::kLeft)), subtree(skeleton_.ankle(Side::kRight)),
+            placed);
 }
 
 }  // namespace gk

@@ -82,7 +82,15 @@ class PoseSynthesizer {
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
-  void fk_from(int slot, int first_joint, const glm::mat4& root);
+  // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
+  void fk(int slot, int from, int to, const glm::mat4& root);
+  // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
+  struct JointRange {
+    int from = 0, to = 0;
+  };
+  JointRange subtree(int joint) const;
+  // Forward kinematics of two ranges (overlapping ones in one pass).
+  void fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root);
   void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
   void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
                  float dt);
@@ -91,8 +99,7 @@ class PoseSynthesizer {
   const Skeleton& skeleton_;
   int num_joints_;
   bool make_palettes_;
-  std::vector<glm::quat>
-      rest_model_rot_inv_;  // inverse rest model rotations: rest-relative forward
+  std::vector<glm::vec3> rest_forward_;  // per joint, +z of the rest pose in the joint's frame
   std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::quat> local_rot_;
   std::vector<glm::vec3> local_trans_;
@@ -109,12 +116,14 @@ class PoseSynthesizer {
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
-  int first_leg_joint_ = 0;
-  int first_spine_joint_ = 0;
+  std::vector<int> subtree_end_;  // subtree_ends(skeleton_)
+  JointRange leg_range_[2];       // per side, what moves when leg IK turns the hip and the knee
+  bool affine_inverse_bind_ = false;
+  bool stream_palettes_ = false;
 };
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
-// +z): heading [rad].
-float joint_heading(const glm::mat4& world, const glm::quat& rest_model_rot_inv);
+// +z; rest_forward is that +z in the joint's own frame): heading [rad].
+float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward);
 
 }  // namespace gk

@@ -9,6 +9,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "animation/pose_jobs.h"
+#include "animation/procedural.h"
 
 namespace gk {
 namespace {
@@ -93,6 +94,91 @@ TEST(BlendPosesJob, WeightedMeanAndHemisphere) {
   EXPECT_LT(deg, 35.0f);
 }
 
+// Random unit quaternions, about half of them in the far hemisphere of `near` (the same rotation
+// with the other sign), so the shortest-arc sign flips are exercised.
+std::vector<glm::quat> random_quats(int n, std::mt19937& rng, const std::vector<glm::quat>* near) {
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::quat> q(n);
+  for (int i = 0; i < n; ++i) {
+    q[i] = glm::normalize(glm::quat(u(rng), u(rng), u(rng), u(rng)));
+    if (near && glm::dot(q[i], (*near)[i]) > 0.0f && (i % 2)) q[i] = -q[i];
+  }
+  return q;
+}
+
+// Many joints (four at a time and a remainder): each one as the single-joint formula has it.
+TEST(SampleClipJob, EveryJointIsTheShortestArcNlerpOfItsFrames) {
+  const int n = 11;
+  std::mt19937 rng(9);
+  Clip c;
+  c.name = "many";
+  c.fps = 10.0f;
+  c.num_frames = 2;
+  c.num_joints = n;
+  const std::vector<glm::quat> f0 = random_quats(n, rng, nullptr);
+  const std::vector<glm::quat> f1 = random_quats(n, rng, &f0);
+  c.rotations = f0;
+  c.rotations.insert(c.rotations.end(), f1.begin(), f1.end());
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 2 * n; ++i) c.translations.push_back(glm::vec3(u(rng), u(rng), u(rng)));
+  std::vector<glm::quat> r(n);
+  std::vector<glm::vec3> t(n);
+  const float w = 0.3f;
+  SampleClipJob job{&c, w / c.fps, r, t};
+  ASSERT_TRUE(job.validate());
+  job.run();
+  for (int j = 0; j < n; ++j) {
+    const glm::quat b = glm::dot(f0[j], f1[j]) < 0.0f ? -f1[j] : f1[j];
+    const glm::quat want = glm::normalize(f0[j] * (1.0f - w) + b * w);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(r[j][k], want[k], 1e-6f) << "joint " << j;
+    const glm::vec3 want_t = glm::mix(c.translations[j], c.translations[n + j], w);
+    EXPECT_NEAR(glm::length(t[j] - want_t), 0.0f, 1e-6f) << "joint " << j;
+  }
+}
+
+TEST(BlendPosesJob, TwoLayersOfManyJointsEachAsTheFormula) {
+  const int n = 10;
+  std::mt19937 rng(4);
+  const std::vector<glm::quat> a = random_quats(n, rng, nullptr);
+  const std::vector<glm::quat> b = random_quats(n, rng, &a);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::vec3> ta(n), tb(n);
+  for (int i = 0; i < n; ++i) {
+    ta[i] = glm::vec3(u(rng), u(rng), u(rng));
+    tb[i] = glm::vec3(u(rng), u(rng), u(rng));
+  }
+  // A weightless layer between them is skipped.
+  PoseLayer layers[3] = {{a, ta, 2.0f}, {b, tb, 0.0f}, {b, tb, 1.0f}};
+  std::vector<glm::quat> r(n);
+  std::vector<glm::vec3> t(n);
+  BlendPosesJob job{layers, r, t};
+  ASSERT_TRUE(job.validate());
+  job.run();
+  for (int j = 0; j < n; ++j) {
+    const glm::quat bj = glm::dot(a[j], b[j]) < 0.0f ? -b[j] : b[j];
+    const glm::quat want = glm::normalize(a[j] * (2.0f / 3.0f) + bj * (1.0f / 3.0f));
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(r[j][k], want[k], 1e-6f) << "joint " << j;
+    EXPECT_NEAR(glm::length(t[j] - (ta[j] * (2.0f / 3.0f) + tb[j] * (1.0f / 3.0f))), 0.0f, 1e-6f)
+        << "joint " << j;
+  }
+}
+
+TEST(BlendPosesJob, OneWeightedLayerIsCopied) {
+  const glm::quat a = glm::angleAxis(glm::radians(20.0f), glm::vec3(0, 0, 1));
+  const glm::quat b = glm::angleAxis(glm::radians(70.0f), glm::vec3(1, 0, 0));
+  glm::vec3 ta(0.3f, 0.2f, 0.1f), tb(4, 0, 0);
+  PoseLayer layers[2] = {{{&a, 1}, {&ta, 1}, 0.0f}, {{&b, 1}, {&tb, 1}, 0.7f}};
+  glm::quat r;
+  glm::vec3 t;
+  BlendPosesJob{layers, {&r, 1}, {&t, 1}}.run();
+  EXPECT_EQ(r, b);
+  EXPECT_EQ(t, tb);
+  layers[1].weight = 0.0f;  // nothing weighted: the first layer
+  BlendPosesJob{layers, {&r, 1}, {&t, 1}}.run();
+  EXPECT_EQ(r, a);
+  EXPECT_EQ(t, ta);
+}
+
 TEST(LocalToModelJob, ChainGeometry) {
   const Skeleton s = make_chain(3, 0.5f);
   std::vector<glm::quat> r(3, glm::quat(1, 0, 0, 0));
@@ -106,6 +192,89 @@ TEST(LocalToModelJob, ChainGeometry) {
   EXPECT_NEAR(translation_of(m[1]).y, 1.5f, 1e-6f);
   EXPECT_NEAR(translation_of(m[2]).y, 1.5f, 1e-6f);
   EXPECT_NEAR(translation_of(m[2]).z, -0.5f, 1e-6f);
+}
+
+// A random local pose: rest translations, rotations within about 45 degrees of identity.
+void random_pose(const Skeleton& s, std::mt19937& rng, std::vector<glm::quat>* r,
+                 std::vector<glm::vec3>* t) {
+  std::uniform_real_distribution<float> u(-0.4f, 0.4f);
+  r->resize(s.num_joints());
+  for (glm::quat& q : *r) q = glm::normalize(glm::quat(1.0f, u(rng), u(rng), u(rng)));
+  *t = s.rest_translations;
+}
+
+bool same(const glm::mat4& a, const glm::mat4& b) { return a == b; }
+
+TEST(LocalToModelJob, EqualsThePlainMatrixProduct) {
+  const auto s = make_humanoid_skeleton();
+  std::mt19937 rng(11);
+  std::vector<glm::quat> r;
+  std::vector<glm::vec3> t;
+  random_pose(*s, rng, &r, &t);
+  const glm::mat4 root = glm::translate(glm::mat4(1), glm::vec3(3, 0.1f, -2)) *
+                         glm::mat4_cast(glm::angleAxis(0.7f, glm::vec3(0, 1, 0)));
+  std::vector<glm::mat4> m(s->num_joints());
+  LocalToModelJob{s.get(), r, t, root, m}.run();
+  for (int j = 0; j < s->num_joints(); ++j) {
+    glm::mat4 local = glm::mat4_cast(r[j]);
+    local[3] = glm::vec4(t[j], 1.0f);
+    const int p = s->parents[j];
+    EXPECT_TRUE(same(m[j], (p < 0 ? root : m[p]) * local)) << s->names[j];
+  }
+}
+
+TEST(LocalToModelJob, RangeRecomputesOnlyItsJoints) {
+  const Skeleton s = make_chain(5, 0.5f);
+  std::vector<glm::quat> r(5, glm::angleAxis(0.3f, glm::vec3(1, 0, 0)));
+  std::vector<glm::mat4> full(5), part(5);
+  LocalToModelJob{&s, r, s.rest_translations, glm::mat4(1), full}.run();
+  const glm::mat4 sentinel(2.0f);
+  part = full;
+  part[1] = part[2] = part[3] = sentinel;
+  LocalToModelJob job{&s, r, s.rest_translations, glm::mat4(1), part, 1, 3};
+  ASSERT_TRUE(job.validate());
+  job.run();
+  EXPECT_TRUE(same(part[1], full[1]));
+  EXPECT_TRUE(same(part[2], full[2]));
+  EXPECT_TRUE(same(part[3], sentinel));  // past the range: untouched
+  EXPECT_FALSE((LocalToModelJob{&s, r, s.rest_translations, glm::mat4(1), part, 3, 2}.validate()));
+  EXPECT_FALSE((LocalToModelJob{&s, r, s.rest_translations, glm::mat4(1), part, 0, 6}.validate()));
+}
+
+// After one joint's local transform changes, recomputing its subtree range gives the full pass's
+// pose to the bit, on every joint of the built-in rig, which is depth-first (every range is exactly
+// the joint's subtree, so the update is partial).
+TEST(LocalToModelJob, SubtreeUpdateAfterOneJointChangedEqualsFullPass) {
+  const auto s = make_humanoid_skeleton();
+  const int n = s->num_joints();
+  const std::vector<int> ends = subtree_ends(*s);
+  ASSERT_EQ(static_cast<int>(ends.size()), n);
+  std::mt19937 rng(5);
+  std::vector<glm::quat> r;
+  std::vector<glm::vec3> t;
+  random_pose(*s, rng, &r, &t);
+  const glm::mat4 root = glm::translate(glm::mat4(1), glm::vec3(1, 0.05f, 2));
+  std::vector<glm::mat4> before(n), full(n), part(n);
+  LocalToModelJob{s.get(), r, t, root, before}.run();
+  for (int j = 0; j < n; ++j) {
+    int descendants = 0;
+    for (int k = j + 1; k < n; ++k) {
+      for (int a = s->parents[k]; a >= 0; a = s->parents[a]) descendants += a == j;
+    }
+    EXPECT_EQ(ends[j] - j, descendants + 1) << s->names[j];
+    std::vector<glm::quat> r2 = r;
+    std::vector<glm::vec3> t2 = t;
+    r2[j] = glm::normalize(r2[j] * glm::angleAxis(0.5f, glm::normalize(glm::vec3(1, 0.5f, 0.2f))));
+    t2[j] += glm::vec3(0.02f, -0.01f, 0.0f);
+    LocalToModelJob{s.get(), r2, t2, root, full}.run();
+    part = before;
+    LocalToModelJob job{s.get(), r2, t2, root, part, j, ends[j]};
+    ASSERT_TRUE(job.validate());
+    job.run();
+    for (int k = 0; k < n; ++k) {
+      EXPECT_TRUE(same(part[k], full[k])) << "changed " << s->names[j] << ", joint " << s->names[k];
+    }
+  }
 }
 
 TEST(TwoBoneIKJob, ReachesRandomTargetsWithKneeTowardPole) {
@@ -238,6 +407,31 @@ TEST(TwoBoneIKJob, SoftenedKneeStraightensWithoutASnap) {
   glm::vec3 end;
   knee_and_end(0.7f, 0.95f, &end);
   EXPECT_NEAR(glm::length(end), 0.7f, 1e-4f);
+}
+
+TEST(SkinningPaletteJob, AffineProductEqualsTheFullOne) {
+  const auto s = make_humanoid_skeleton();
+  const int n = s->num_joints();
+  std::mt19937 rng(2);
+  std::vector<glm::quat> r;
+  std::vector<glm::vec3> t;
+  std::vector<glm::mat4> rest(n), m(n), inv(n), full(n), affine(n);
+  LocalToModelJob{s.get(), s->rest_rotations, s->rest_translations, glm::mat4(1), rest}.run();
+  for (int i = 0; i < n; ++i) {
+    inv[i] = glm::mat4(glm::inverse(glm::mat3(rest[i])));
+    inv[i][3] = glm::vec4(-(glm::mat3(inv[i]) * glm::vec3(rest[i][3])), 1.0f);
+  }
+  random_pose(*s, rng, &r, &t);
+  LocalToModelJob{s.get(), r, t, glm::translate(glm::mat4(1), glm::vec3(4, 0, 1)), m}.run();
+  ASSERT_TRUE(is_affine(inv));
+  SkinningPaletteJob{m, inv, full, false}.run();
+  SkinningPaletteJob{m, inv, affine, true}.run();
+  for (int i = 0; i < n; ++i) EXPECT_TRUE(same(full[i], affine[i])) << s->names[i];
+  std::vector<glm::mat4> streamed(n);
+  SkinningPaletteJob{m, inv, streamed, true, true}.run();
+  for (int i = 0; i < n; ++i) EXPECT_TRUE(same(full[i], streamed[i])) << s->names[i];
+  inv[3][1][3] = 1e-7f;  // not affine any more
+  EXPECT_FALSE(is_affine(inv));
 }
 
 TEST(SkinningPaletteJob, BindPoseGivesIdentity) {

@@ -72,6 +72,30 @@ Skeleton biped(const std::string& hips, const std::vector<std::string>& spine,
   return make_skeleton(j);
 }
 
+TEST(SkeletonSubtrees, DepthFirstRangesAreExactOthersRunToTheEnd) {
+  const Skeleton dfs = make_skeleton({{"hips", ""},
+                                      {"spine", "hips"},
+                                      {"chest", "spine"},
+                                      {"l_hip", "hips"},
+                                      {"l_knee", "l_hip"},
+                                      {"r_hip", "hips"},
+                                      {"r_knee", "r_hip"}});
+  EXPECT_EQ(subtree_ends(dfs), (std::vector<int>{7, 3, 3, 5, 5, 7, 7}));
+  // Breadth first: spine, l_hip and r_hip have a joint of another branch between them and their
+  // children, so their ranges run to the last joint; the leaves' ranges are themselves.
+  const Skeleton bfs = make_skeleton({{"hips", ""},
+                                      {"spine", "hips"},
+                                      {"l_hip", "hips"},
+                                      {"r_hip", "hips"},
+                                      {"chest", "spine"},
+                                      {"l_knee", "l_hip"},
+                                      {"r_knee", "r_hip"}});
+  EXPECT_EQ(subtree_ends(bfs), (std::vector<int>{7, 7, 7, 7, 5, 6, 7}));
+  // Two roots: each one's range stops at the other.
+  const Skeleton two = make_skeleton({{"a", ""}, {"a1", "a"}, {"b", ""}, {"b1", "b"}});
+  EXPECT_EQ(subtree_ends(two), (std::vector<int>{2, 2, 4, 4}));
+}
+
 TEST(SkeletonRoles, RoleNamesRoundTrip) {
   for (int r = 0; r < kNumJointRoles; ++r) {
     JointRole back;
