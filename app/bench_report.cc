@@ -83,6 +83,7 @@ json to_json(const BenchReport& r) {
   } else {
     out["crowd"] = nullptr;
   }
+  out["render"] = r.render ? *r.render : json(nullptr);
   return out;
 }
 

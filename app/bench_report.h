@@ -98,6 +98,9 @@ struct BenchReport {
   std::optional<double> us_per_agent;     // median total / agents * 1000
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists
   std::optional<CrowdReport> crowd;
+  // --render: what was drawn (mesh levels, triangles, agents per level) and the render stage's
+  // CPU time; null without --render.
+  std::optional<nlohmann::json> render;
 };
 
 nlohmann::json to_json(const BenchReport& report);
