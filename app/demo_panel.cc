@@ -319,9 +319,10 @@ void DemoApp::panel_mesh_lod() {
   const RenderStats& st = r.stats();
   ImGui::Checkbox("mesh LOD", &mesh_lod_);
   if (ImGui::IsItemHovered()) {
-    ImGui::SetTooltip("Lighter meshes for agents small on screen: each agent gets the lightest "
-                      "level whose error stays under %.1f px (--mesh-lod)",
-                      r.settings().mesh_lod_selection.max_error_px);
+    ImGui::SetTooltip(
+        "Lighter meshes for agents small on screen: each agent gets the lightest "
+        "level whose error stays under %.1f px (--mesh-lod)",
+        r.settings().mesh_lod_selection.max_error_px);
   }
   ImGui::SameLine();
   ImGui::Text("%.3fM agent triangles drawn", static_cast<double>(st.agent_triangles) * 1e-6);

@@ -195,8 +195,8 @@ int CrowdRenderer::cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport
     int level = 0;
     if (settings_.mesh_lod && m.num_lods > 1) {
       uint8_t& last = lod_of_block_[palette_block(a, i)];
-      const float ppm = pixels_per_metre(y_scale, viewport_px.y,
-                                         glm::dot(depth_row, glm::vec4(center, 1.0f)));
+      const float ppm =
+          pixels_per_metre(y_scale, viewport_px.y, glm::dot(depth_row, glm::vec4(center, 1.0f)));
       level = choose_mesh_lod(std::span(m.lod_error_m).first(m.num_lods), ppm,
                               settings_.mesh_lod_selection, last == kNoLod ? -1 : last);
       last = static_cast<uint8_t>(level);

@@ -87,9 +87,9 @@ struct RenderStats {
   int agents_visible = 0;
   int agents_culled = 0;
   int lines_drawn = 0;
-  int lines_dropped = 0;  // add_line calls beyond max_debug_lines, since the last draw
-  int triangles_drawn = 0;     // debug triangles (add_triangle)
-  int triangles_dropped = 0;  // add_triangle calls beyond max_debug_triangles
+  int lines_dropped = 0;        // add_line calls beyond max_debug_lines, since the last draw
+  int triangles_drawn = 0;      // debug triangles (add_triangle)
+  int triangles_dropped = 0;    // add_triangle calls beyond max_debug_triangles
   int64_t agent_triangles = 0;  // skinned triangles drawn: instances times their level's triangles
   std::array<int, kMaxMeshLods> agents_per_lod{};  // visible agents drawn with each mesh level
 };

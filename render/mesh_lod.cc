@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
-#include <glm/geometric.hpp>
 #include <meshoptimizer.h>
+#include <glm/geometric.hpp>
 
 namespace gk {
 namespace {
@@ -41,8 +41,7 @@ std::vector<uint32_t> weld(const SkinnedMesh& mesh, std::span<const uint32_t> in
   }
   std::vector<uint32_t> welded(indices.size());
   meshopt_generateShadowIndexBuffer(welded.data(), indices.data(), indices.size(), keys.data(), n,
-                                    kWeldKeyInts * sizeof(int32_t),
-                                    kWeldKeyInts * sizeof(int32_t));
+                                    kWeldKeyInts * sizeof(int32_t), kWeldKeyInts * sizeof(int32_t));
   return welded;
 }
 
@@ -91,8 +90,9 @@ Result<MeshLodChain> build_mesh_lods(const SkinnedMesh& mesh, std::span<const ui
   }
   if (mesh.normals.size() != n || mesh.joints.size() != n || mesh.weights.size() != n ||
       (!mesh.colors.empty() && mesh.colors.size() != n)) {
-    return Status::Error("mesh lod: normals/joints/weights/colors must have one entry per vertex (" +
-                         std::to_string(n) + ")");
+    return Status::Error(
+        "mesh lod: normals/joints/weights/colors must have one entry per vertex (" +
+        std::to_string(n) + ")");
   }
   for (size_t i = 0; i < indices.size(); ++i) {
     if (indices[i] >= n) {
@@ -157,8 +157,8 @@ Result<MeshLodChain> build_mesh_lods(const SkinnedMesh& mesh, std::span<const ui
     double volume = 0.0, area = 0.0;
     volume_and_area(mesh.positions, level.indices, &volume, &area);
     if (full_volume > 0.0 && area > 0.0) {
-      level.inflate_m = std::clamp(static_cast<float>((full_volume - volume) / area), 0.0f,
-                                   level.error_m);
+      level.inflate_m =
+          std::clamp(static_cast<float>((full_volume - volume) / area), 0.0f, level.error_m);
     }
     chain.levels.push_back(std::move(level));
   }

@@ -70,7 +70,7 @@ Result<MeshLodChain> build_mesh_lods(const SkinnedMesh& mesh, std::span<const ui
 
 struct MeshLodSelection {
   // Largest projected error of the level drawn [px] [Limit: >= 0; 0 keeps the full mesh].
-  float max_error_px = 0.5f;
+  float max_error_px = 1.0f;
   // A lighter level is taken only when its error is below (1 - hysteresis) * max_error_px; a
   // heavier one as soon as the current level's error exceeds max_error_px [Limit: [0, 1)].
   float hysteresis = 0.25f;

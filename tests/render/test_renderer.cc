@@ -216,8 +216,8 @@ TEST_F(RendererTest, MeshLodDrawsFarAgentsLighterAndKeepsTheCrowdsLook) {
   EXPECT_GT(lod_stats.agents_per_lod[kMaxMeshLods - 1], 0);
   int64_t expected_triangles = 0;
   for (int l = 0; l < kMaxMeshLods; ++l) {
-    expected_triangles += static_cast<int64_t>(lod_stats.agents_per_lod[l]) *
-                          renderer_->mesh_lod_triangles(*mesh, l);
+    expected_triangles +=
+        static_cast<int64_t>(lod_stats.agents_per_lod[l]) * renderer_->mesh_lod_triangles(*mesh, l);
   }
   EXPECT_EQ(lod_stats.agent_triangles, expected_triangles);
   EXPECT_LT(lod_stats.agent_triangles * 2, full_stats.agent_triangles);
