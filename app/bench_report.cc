@@ -98,6 +98,7 @@ json to_json(const BenchReport& r) {
   } else {
     out["lod"] = nullptr;
   }
+  out["render"] = r.render ? *r.render : json(nullptr);
   return out;
 }
 

@@ -113,6 +113,9 @@ struct BenchReport {
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists
   std::optional<CrowdReport> crowd;
   std::optional<LodReport> lod;  // null without --lod
+  // --render: what was drawn (mesh levels, triangles, agents per level) and the render stage's
+  // CPU time; null without --render.
+  std::optional<nlohmann::json> render;
 };
 
 nlohmann::json to_json(const BenchReport& report);

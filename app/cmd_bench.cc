@@ -3,6 +3,7 @@
 // The frame loop is CrowdPipeline's (through CrowdSession), which also records the metrics and
 // the joint dump; --render adds the upload and render stages, offscreen.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -24,6 +25,8 @@
 #include "mediator/mediator.h"
 #include "mediator/metrics.h"
 #include "mediator/pose_synthesis.h"
+#include "mediator/quantile_sketch.h"
+#include "render/crowd_renderer.h"
 
 namespace gk::app {
 namespace {
@@ -42,6 +45,7 @@ struct BenchOptions {
   std::string dump_joint_names;
   bool render = false;
   std::string size = "1280x720";
+  std::string mesh_lod = "on";
   std::string progress_every = "0";
   bool lod = false;
   std::string lod_distances;
@@ -163,6 +167,40 @@ std::vector<std::string> split_names(const std::string& list) {
   return out;
 }
 
+// --render: what the renderer drew on the timed frames and the render stage's CPU time (all the
+// process's threads: the software rasteriser's too), which a loaded machine does not inflate.
+struct RenderTally {
+  int frames = 0;
+  int64_t agent_triangles = 0;
+  std::array<int64_t, kMaxMeshLods> agents_per_lod{};
+  QuantileSketch cpu_ms;
+
+  void add(const RenderStats& stats, double cpu_ms_of_frame) {
+    ++frames;
+    agent_triangles += stats.agent_triangles;
+    for (int l = 0; l < kMaxMeshLods; ++l) agents_per_lod[l] += stats.agents_per_lod[l];
+    cpu_ms.add(cpu_ms_of_frame);
+  }
+  nlohmann::json to_json(const CrowdRenderer& renderer, bool mesh_lod, glm::ivec2 size) const {
+    const double n = std::max(frames, 1);
+    nlohmann::json levels = nlohmann::json::array();
+    nlohmann::json per_level = nlohmann::json::array();
+    for (int l = 0; l < renderer.num_mesh_lods(0); ++l) {
+      levels.push_back({{"triangles", renderer.mesh_lod_triangles(0, l)},
+                        {"error_m", renderer.mesh_lod_error_m(0, l)}});
+      per_level.push_back(static_cast<double>(agents_per_lod[l]) / n);
+    }
+    return {{"size", std::to_string(size.x) + "x" + std::to_string(size.y)},
+            {"mesh_lod", mesh_lod},
+            {"mesh_levels", levels},
+            {"agents_per_level", per_level},
+            {"agent_triangles_per_frame", static_cast<double>(agent_triangles) / n},
+            {"cpu_ms", frames > 0 ? nlohmann::json{{"median", cpu_ms.nearest_rank(0.5)},
+                                                   {"p95", cpu_ms.nearest_rank(0.95)}}
+                                  : nlohmann::json(nullptr)}};
+  }
+};
+
 void run_bench(const BenchOptions& o) {
   const int frames = parse_number<int>("bench", o.frames, "--frames", 1, kMaxFrames);
   // Output paths are checked before the work starts, not after minutes of simulation.
@@ -200,6 +238,8 @@ void run_bench(const BenchOptions& o) {
   // --render: the upload and render stages, offscreen, timed to completion with glFinish.
   std::optional<OffscreenScene> scene;
   if (o.render) scene.emplace(open_offscreen_scene("bench", *session, o.size));
+  if (scene) scene->view->renderer().settings().mesh_lod = o.mesh_lod == "on";
+  RenderTally render_tally;
 
   StageTimer timer(kWarmupFrames);
   CrowdReport crowd_stats;
@@ -229,6 +269,7 @@ void run_bench(const BenchOptions& o) {
         return s;
       });
       if (!uploaded.ok()) fail(1, "frame " + std::to_string(f) + ": " + uploaded.message());
+      const double render_cpu_start_ms = process_cpu_ms();
       const Status drawn = timer.time(Stage::kRender, f, [&] {
         scene->context->begin_frame();
         Status s = scene->view->draw(session->lane(), glm::ivec2(0), scene->size);
@@ -236,6 +277,9 @@ void run_bench(const BenchOptions& o) {
         return s;
       });
       if (!drawn.ok()) fail(1, "frame " + std::to_string(f) + ": " + drawn.message());
+      if (f >= kWarmupFrames) {
+        render_tally.add(scene->view->renderer().stats(), process_cpu_ms() - render_cpu_start_ms);
+      }
     }
     const double frame_total_ms = StageTimer::ms_since(frame_start) - measured_in_step.measure_ms;
     if (o.lod && f >= kWarmupFrames) {
@@ -362,6 +406,9 @@ void run_bench(const BenchOptions& o) {
     lod_stats.mean_agents_updated /= n;
     report.lod = lod_stats;
   }
+  if (scene) {
+    report.render = render_tally.to_json(scene->view->renderer(), o.mesh_lod == "on", scene->size);
+  }
   report.mode = std::string(mediator_mode_name(params.mode));
   report.joints = library.skeleton->num_joints();
   report.clips = library.clip_names();
@@ -378,6 +425,22 @@ void run_bench(const BenchOptions& o) {
   std::printf("  v1 contact band excess (0 = METRICS.md exactly): toe %.3f mm, ankle %.3f mm\n",
               1000.0 * measured.slide_toe_band_excess_m,
               1000.0 * measured.slide_ankle_band_excess_m);
+  if (report.render) {
+    const nlohmann::json& r = *report.render;
+    std::string levels;
+    for (const auto& n : r["agents_per_level"]) {
+      char v[32];
+      std::snprintf(v, sizeof(v), " %.1f", n.get<double>());
+      levels += v;
+    }
+    std::printf("  render %s, mesh lod %s: %.0f agent triangles per frame, agents per level:%s",
+                r["size"].get<std::string>().c_str(), o.mesh_lod.c_str(),
+                r["agent_triangles_per_frame"].get<double>(), levels.c_str());
+    if (!r["cpu_ms"].is_null()) {
+      std::printf("; CPU median %.2f ms", r["cpu_ms"]["median"].get<double>());
+    }
+    std::printf("\n");
+  }
   if (measured.non_finite > 0) {
     std::printf("  NaN or infinite joint coordinates or samples: %lld\n",
                 static_cast<long long>(measured.non_finite));
@@ -406,6 +469,9 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--render", options->render,
                 "Also render every frame offscreen (EGL) and time the upload and render stages");
   cmd->add_option("--size", options->size, "Frame size of --render, WxH (default 1280x720)");
+  cmd->add_option("--mesh-lod", options->mesh_lod,
+                  "With --render: lighter meshes for agents small on screen, on (default) or off")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_flag("--loop", options->crowd.loop,
                 "Run the crowd round and round: a replayed file starts over after its last "
                 "sample; a scenario whose agents leave at their goal starts a new round (seed + 1, "

@@ -32,6 +32,9 @@ void add_demo_command(CLI::App& app) {
                   "Open on a lesson: " + lesson_names() +
                       " (scenario, camera, speed, overlays and a split of that one idea off | on)");
   cmd->add_option("--select", options->select, "Agent id to select and follow from the start");
+  cmd->add_option("--mesh-lod", options->mesh_lod,
+                  "Lighter meshes for agents small on screen, on (default) or off")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--pull-out", options->pull_out,
                   "With --select: at this simulated time [s] the camera pulls out to the whole "
                   "scene");

@@ -43,6 +43,7 @@ struct RenderOptions {
   std::string pull_out;
   std::string report;
   std::string lesson;
+  std::string mesh_lod = "on";
 };
 
 std::string upper(std::string_view text) {
@@ -306,6 +307,7 @@ void run_render(RenderOptions& o) {
                     scene.view->renderer().settings().wall_thickness_m);
   // Overlays are teaching aids: they stay visible through the bodies.
   scene.view->renderer().settings().lines_on_top = overlays.any();
+  scene.view->renderer().settings().mesh_lod = o.mesh_lod == "on";
 
   FILE* video = nullptr;
   if (kind == OutputKind::kVideo) {
@@ -476,6 +478,9 @@ void add_render_command(CLI::App& app) {
                   "A lesson's scene: " + lesson_names() +
                       " (scenario, follow camera, overlays, split of that one idea off | on, the "
                       "caption)");
+  cmd->add_option("--mesh-lod", options->mesh_lod,
+                  "Lighter meshes for agents small on screen, on (default) or off")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--report", options->report,
                   "Write the last frame's agent positions and image pixels as JSON");
   cmd->callback([options] { run_render(*options); });

@@ -35,6 +35,7 @@ constexpr float kStepBudget_ms = 40.0f;
 DemoApp::DemoApp(DemoOptions options) : options_(std::move(options)) {
   crowd_ = options_.crowd;
   crowd_.command = "demo";
+  mesh_lod_ = options_.mesh_lod != "off";
   if (const Lesson* l = find_lesson(options_.lesson)) crowd_.scenario = l->scenario;
   showcase_ = crowd_.scenario.empty();
   if (showcase_) {
@@ -231,6 +232,7 @@ Status DemoApp::render_scene(float real_dt_s) {
                    shown_followed(), &camera_);
   view_->camera() = camera_;
   view_->renderer().settings().lines_on_top = overlays_.any();
+  view_->renderer().settings().mesh_lod = mesh_lod_;
   context_->begin_frame();
   // The panel is drawn over the right edge; clear it too, the renderer clears only its regions.
   glClearColor(0.1f, 0.1f, 0.12f, 1.0f);

@@ -49,6 +49,7 @@ struct DemoOptions {
   std::vector<std::string> inputs;
   std::string report;  // JSON: panel rectangle and the agents' pixels on the last frame
   std::string lesson;  // open on this lesson (app/lessons.h)
+  std::string mesh_lod = "on";  // lighter meshes for agents small on screen: on | off
 };
 
 // Width of the panel docked at the right edge of the window [px]; the 3D view fills the rest.
@@ -105,6 +106,7 @@ class DemoApp {
   void panel_params();
   void panel_view();
   void panel_metrics();
+  void panel_mesh_lod();  // triangles drawn and agents per mesh level, the LOD switch
   void panel_agent();
   void panel_lod();  // level of detail of the primary lane, focused on the camera
   void handle_browser();
@@ -140,6 +142,7 @@ class DemoApp {
   bool paused_ = false;
   bool step_requested_ = false;
   bool help_ = false;
+  bool mesh_lod_ = true;  // the renderer's mesh levels of detail (View panel, --mesh-lod)
   bool help_focused_ = false;  // the help window was brought to the front since it opened
   bool quit_ = false;
   bool restart_requested_ = false;

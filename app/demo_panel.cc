@@ -336,6 +336,7 @@ void DemoApp::panel_metrics() {
   } else {
     ImGui::TextDisabled("simulation %s", paused_ ? "paused" : "keeps real time");
   }
+  panel_mesh_lod();
   const int n = metrics_.count();
   for (int s = 0; s < kNumLiveSeries; ++s) {
     const auto series = static_cast<LiveSeries>(s);
@@ -361,6 +362,30 @@ void DemoApp::panel_metrics() {
   }
   ImGui::PlotLines("frame ms", metrics_.stage_series(), metrics_.stage_count(), 0, nullptr, 0.0f,
                    FLT_MAX, ImVec2(0, 36));
+}
+
+void DemoApp::panel_mesh_lod() {
+  // What the last draw (the right half of a split) cost the rasteriser, and where its agents went.
+  const CrowdRenderer& r = view_->renderer();
+  const RenderStats& st = r.stats();
+  ImGui::Checkbox("mesh LOD", &mesh_lod_);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip(
+        "Lighter meshes for agents small on screen: each agent gets the lightest "
+        "level whose error stays under %.1f px (--mesh-lod)",
+        r.settings().mesh_lod_selection.max_error_px);
+  }
+  ImGui::SameLine();
+  ImGui::Text("%.3fM agent triangles drawn", static_cast<double>(st.agent_triangles) * 1e-6);
+  char agents[96] = "", triangles[96] = "";
+  for (int l = 0, a = 0, t = 0; l < r.num_mesh_lods(0); ++l) {
+    const char* sep = l > 0 ? " | " : "";
+    a += std::snprintf(agents + a, sizeof(agents) - a, "%s%d", sep, st.agents_per_lod[l]);
+    t += std::snprintf(triangles + t, sizeof(triangles) - t, "%s%d", sep,
+                       r.mesh_lod_triangles(0, l));
+  }
+  ImGui::Text("agents per level  %s", agents);
+  ImGui::TextDisabled("triangles each    %s", triangles);
 }
 
 void DemoApp::panel_agent() {

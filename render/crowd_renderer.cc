@@ -69,6 +69,7 @@ Status CrowdRenderer::init(const RendererConfig& config) {
   }
   glUseProgram(skinned_program_.id());
   glUniform1i(skinned_program_.uniform("u_palette"), 0);
+  lod_inflate_uniform_ = skinned_program_.uniform("u_lod_inflate_m");
   glUseProgram(0);
 
   initialized_ = true;  // from here release() owns whatever was created
@@ -129,6 +130,7 @@ Status CrowdRenderer::init(const RendererConfig& config) {
 
   instances_.resize(instance_capacity_);
   visible_.resize(instance_capacity_);
+  visible_lod_.resize(instance_capacity_);
   lines_.reserve(static_cast<size_t>(config.max_debug_lines) * 2);
   triangles_.reserve(static_cast<size_t>(config.max_debug_triangles) * 3);
   if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
@@ -165,13 +167,21 @@ Status CrowdRenderer::upload_palettes(std::span<const glm::mat4> palettes, int j
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
   num_palette_agents_ = static_cast<int>(num_matrices / joints_per_agent);
   joints_per_agent_ = joints_per_agent;
+  if (lod_of_block_.size() < static_cast<size_t>(num_palette_agents_)) {
+    lod_of_block_.resize(std::max<size_t>(num_palette_agents_, lod_of_block_.size() * 3 / 2),
+                         kNoLod);
+  }
   return Status::Ok();
 }
 
 int CrowdRenderer::cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport_px,
                                   std::span<const AgentDraw> agents) {
   const Frustum frustum(camera.view_projection(viewport_px));
-  std::fill(mesh_count_.begin(), mesh_count_.end(), 0);
+  // Depth along the view direction: the third row of the view matrix (negated: GL looks down -z).
+  const glm::mat4 view = camera.view();
+  const glm::vec4 depth_row(-view[0][2], -view[1][2], -view[2][2], -view[3][2]);
+  const float y_scale = camera.projection(viewport_px)[1][1];
+  std::fill(bucket_count_.begin(), bucket_count_.end(), 0);
   int num_visible = 0;
   for (size_t i = 0; i < agents.size(); ++i) {
     const AgentDraw& a = agents[i];
@@ -182,14 +192,24 @@ int CrowdRenderer::cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport
     if (!finite || (settings_.cull_agents && !frustum.intersects_sphere(center, m.radius_m))) {
       continue;
     }
-    visible_[num_visible++] = static_cast<int>(i);
-    ++mesh_count_[a.mesh];
+    int level = 0;
+    if (settings_.mesh_lod && m.num_lods > 1) {
+      uint8_t& last = lod_of_block_[palette_block(a, i)];
+      const float ppm =
+          pixels_per_metre(y_scale, viewport_px.y, glm::dot(depth_row, glm::vec4(center, 1.0f)));
+      level = choose_mesh_lod(std::span(m.lod_error_m).first(m.num_lods), ppm,
+                              settings_.mesh_lod_selection, last == kNoLod ? -1 : last);
+      last = static_cast<uint8_t>(level);
+    }
+    visible_[num_visible] = static_cast<int>(i);
+    visible_lod_[num_visible++] = static_cast<uint8_t>(level);
+    ++bucket_count_[a.mesh * kMaxMeshLods + level];
   }
-  // Counting sort by mesh, so each mesh's instances are contiguous for its single draw call.
+  // Counting sort by (mesh, level), so each one's instances are contiguous for its single draw.
   int first = 0;
-  for (size_t k = 0; k < meshes_.size(); ++k) {
-    mesh_first_[k] = first;
-    first += mesh_count_[k];
+  for (size_t b = 0; b < bucket_first_.size(); ++b) {
+    bucket_first_[b] = first;
+    first += bucket_count_[b];
   }
   for (int v = 0; v < num_visible; ++v) {
     const int i = visible_[v];
@@ -197,9 +217,10 @@ int CrowdRenderer::cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport
     const float shadow = meshes_[a.mesh].shadow_radius_m * settings_.shadow_radius_scale;
     const auto base =
         static_cast<uint32_t>(palette_block(a, static_cast<size_t>(i)) * joints_per_agent_);
-    instances_[mesh_first_[a.mesh]++] = {a.tint, base, glm::vec4(a.position, shadow)};
+    instances_[bucket_first_[a.mesh * kMaxMeshLods + visible_lod_[v]]++] = {
+        a.tint, base, glm::vec4(a.position, shadow)};
   }
-  for (size_t k = 0; k < meshes_.size(); ++k) mesh_first_[k] -= mesh_count_[k];
+  for (size_t b = 0; b < bucket_first_.size(); ++b) bucket_first_[b] -= bucket_count_[b];
   return num_visible;
 }
 
@@ -236,6 +257,7 @@ Status CrowdRenderer::draw_region(const OrbitCamera& camera, glm::ivec2 origin_p
   }
   grow_to(&instances_, agents.size());
   grow_to(&visible_, agents.size());
+  grow_to(&visible_lod_, agents.size());
 
   stats_ = {};
   stats_.agents_submitted = static_cast<int>(agents.size());
@@ -296,25 +318,32 @@ void CrowdRenderer::draw_agents() {
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_BUFFER, palette_texture_);
   glBindBuffer(GL_ARRAY_BUFFER, instance_buffer_);
-  for (size_t k = 0; k < meshes_.size(); ++k) {
-    if (mesh_count_[k] == 0) continue;
-    const MeshGpu& m = meshes_[k];
+  for (size_t b = 0; b < bucket_count_.size(); ++b) {
+    const int count = bucket_count_[b];
+    if (count == 0) continue;
+    const MeshGpu& m = meshes_[b / kMaxMeshLods];
+    const int level = static_cast<int>(b % kMaxMeshLods);
     if (m.cull_back_faces && settings_.cull_back_faces) {
       glEnable(GL_CULL_FACE);
     } else {
       glDisable(GL_CULL_FACE);
     }
     glBindVertexArray(m.vao);
-    // GL 3.3 has no base-instance draw, so the instance attributes are pointed at this mesh's
+    // GL 3.3 has no base-instance draw, so the instance attributes are pointed at this bucket's
     // slice; that is state inside the VAO and costs nothing like a buffer upload.
-    const size_t base = static_cast<size_t>(mesh_first_[k]) * sizeof(GpuInstance);
+    const size_t base = static_cast<size_t>(bucket_first_[b]) * sizeof(GpuInstance);
     glVertexAttribPointer(5, 3, GL_FLOAT, GL_FALSE, sizeof(GpuInstance),
                           reinterpret_cast<void*>(base + offsetof(GpuInstance, tint)));
     glVertexAttribIPointer(6, 1, GL_UNSIGNED_INT, sizeof(GpuInstance),
                            reinterpret_cast<void*>(base + offsetof(GpuInstance, palette_base)));
-    glDrawElementsInstanced(GL_TRIANGLES, m.num_indices, GL_UNSIGNED_INT, nullptr, mesh_count_[k]);
+    glUniform1f(lod_inflate_uniform_, m.lod_inflate_m[level]);
+    const size_t first_byte = static_cast<size_t>(m.lod_first[level]) * sizeof(uint32_t);
+    glDrawElementsInstanced(GL_TRIANGLES, m.lod_count[level], GL_UNSIGNED_INT,
+                            reinterpret_cast<void*>(first_byte), count);
     ++stats_.draw_calls;
     ++stats_.skinned_draw_calls;
+    stats_.agents_per_lod[level] += count;
+    stats_.agent_triangles += static_cast<int64_t>(count) * (m.lod_count[level] / 3);
   }
   glDisable(GL_CULL_FACE);
   glBindBuffer(GL_ARRAY_BUFFER, 0);

@@ -4,11 +4,13 @@
 //
 // Per frame:  upload_palettes(all agents' palettes)  ->  add_line(...)*  ->  draw(camera, agents)
 // - All palettes go to the GPU in one upload into a texture buffer (4 RGBA32F texels per mat4).
-// - Agents outside the view frustum are culled on the CPU; the survivors are grouped by mesh in a
-//   preallocated instance array and each mesh is drawn with ONE glDrawElementsInstanced call.
+// - Agents outside the view frustum are culled on the CPU; each survivor gets a level of detail of
+//   its mesh from its size on screen (render/mesh_lod.h); they are grouped by mesh and level in a
+//   preallocated instance array and each (mesh, level) is drawn with ONE glDrawElementsInstanced.
 // - Buffers grow geometrically when a frame needs more; in a steady state nothing is allocated.
 // Needs a current OpenGL 3.3 core context (GlContext) for every call, including destruction.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -22,6 +24,7 @@
 #include "common/status.h"
 #include "render/camera.h"
 #include "render/gl_api.h"
+#include "render/mesh_lod.h"
 #include "render/shader_program.h"
 
 namespace gk {
@@ -71,6 +74,9 @@ struct RenderSettings {
   bool lines_on_top = false;    // true: debug lines ignore depth (overlays stay readable)
   bool cull_agents = true;      // frustum culling (off only to measure its effect)
   bool cull_back_faces = true;  // agents only; add_mesh makes the winding follow the normals
+  // Lighter meshes for agents small on screen (off: every agent with its full mesh).
+  bool mesh_lod = true;
+  MeshLodSelection mesh_lod_selection;  // when a lighter level is good enough (mesh_lod.h)
 };
 
 // Counters of the last draw() (and of add_line since then).
@@ -81,9 +87,11 @@ struct RenderStats {
   int agents_visible = 0;
   int agents_culled = 0;
   int lines_drawn = 0;
-  int lines_dropped = 0;  // add_line calls beyond max_debug_lines, since the last draw
-  int triangles_drawn = 0;
-  int triangles_dropped = 0;  // add_triangle calls beyond max_debug_triangles
+  int lines_dropped = 0;        // add_line calls beyond max_debug_lines, since the last draw
+  int triangles_drawn = 0;      // debug triangles (add_triangle)
+  int triangles_dropped = 0;    // add_triangle calls beyond max_debug_triangles
+  int64_t agent_triangles = 0;  // skinned triangles drawn: instances times their level's triangles
+  std::array<int, kMaxMeshLods> agents_per_lod{};  // visible agents drawn with each mesh level
 };
 
 struct RendererConfig {
@@ -106,8 +114,14 @@ class CrowdRenderer {
   // Uploads a bind-pose mesh; returns its id (0, 1, ...). Validates sizes, indices and joints.
   // Triangles are re-wound to face where their vertex normals point (front = counter-clockwise),
   // which lets the renderer cull back faces even when a generator winds some triangles clockwise.
-  Result<int> add_mesh(const SkinnedMesh& mesh);
+  // It also builds the mesh's chain of lighter levels (build_mesh_lods with `lod_options`).
+  Result<int> add_mesh(const SkinnedMesh& mesh, const MeshLodOptions& lod_options = {});
   int num_meshes() const { return static_cast<int>(meshes_.size()); }
+  // Levels of detail of a mesh (1 = the full mesh only), and each level's triangles and
+  // bind-pose error [m]. `mesh` and `level` must be in range.
+  int num_mesh_lods(int mesh) const { return meshes_[mesh].num_lods; }
+  int mesh_lod_triangles(int mesh, int level) const { return meshes_[mesh].lod_count[level] / 3; }
+  float mesh_lod_error_m(int mesh, int level) const { return meshes_[mesh].lod_error_m[level]; }
 
   // All agents' skinning palettes, block after block, joints_per_agent matrices each (world-space
   // palettes: model[j] * inverse_bind[j] with the agent's placement in model); AgentDraw::palette
@@ -136,12 +150,18 @@ class CrowdRenderer {
                      std::span<const AgentDraw> agents);
 
   RenderSettings& settings() { return settings_; }
+  const RenderSettings& settings() const { return settings_; }
   const RenderStats& stats() const { return stats_; }
 
  private:
   struct MeshGpu {
     GLuint vao = 0, vertex_buffer = 0, index_buffer = 0;
-    GLsizei num_indices = 0;
+    // Levels of detail: level l is lod_count indices from index lod_first of the one index
+    // buffer, over level l's copy of the vertices in the one vertex buffer (its own normals).
+    int num_lods = 1;
+    std::array<GLsizei, kMaxMeshLods> lod_first{}, lod_count{};
+    std::array<float, kMaxMeshLods> lod_error_m{};
+    std::array<float, kMaxMeshLods> lod_inflate_m{};  // MeshLodLevel::inflate_m
     int num_joints = 0;
     float center_height_m = 0.0f;  // bounding sphere centre above the agent's ground point
     float radius_m = 0.0f;         // bounding sphere radius, with margin for animation
@@ -176,6 +196,7 @@ class CrowdRenderer {
   RenderSettings settings_;
   RenderStats stats_;
   ShaderProgram skinned_program_, static_program_, ground_program_, shadow_program_, lines_program_;
+  GLint lod_inflate_uniform_ = -1;  // u_lod_inflate_m of skinned.vert
   GLuint frame_ubo_ = 0;
   GLuint palette_buffer_ = 0, palette_texture_ = 0;
   int64_t palette_capacity_matrices_ = 0;
@@ -195,9 +216,16 @@ class CrowdRenderer {
   std::vector<MeshGpu> meshes_;
   // Per-frame scratch, grown only when a frame brings more agents or lines than ever before.
   std::vector<GpuInstance> instances_;
-  std::vector<int> visible_;       // agent indices that survived culling
-  std::vector<int> mesh_first_;    // first instance of each mesh in instances_
-  std::vector<int> mesh_count_;    // visible instances of each mesh
+  std::vector<int> visible_;          // agent indices that survived culling
+  std::vector<uint8_t> visible_lod_;  // and the mesh level each is drawn with
+  // First instance in instances_ and number of visible instances of each (mesh, level), at
+  // mesh * kMaxMeshLods + level.
+  std::vector<int> bucket_first_;
+  std::vector<int> bucket_count_;
+  // The level each palette block was drawn with last (kNoLod: none yet), for the hysteresis:
+  // a block is one agent for as long as it lives (a mediator slot). Grown with the palettes.
+  static constexpr uint8_t kNoLod = 0xff;
+  std::vector<uint8_t> lod_of_block_;
   std::vector<LineVertex> lines_;      // reserved to 2 * max_debug_lines at init
   std::vector<LineVertex> triangles_;  // reserved to 3 * max_debug_triangles at init
   int dropped_lines_ = 0;

@@ -1,5 +1,5 @@
-// CrowdRenderer::add_mesh: validation, bounds, winding repair and the vertex layout of
-// skinned.vert.
+// CrowdRenderer::add_mesh: validation, bounds, winding repair, the chain of lighter levels and the
+// vertex layout of skinned.vert.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -47,7 +47,7 @@ constexpr float kCullRadiusMargin = 1.3f;
 
 }  // namespace
 
-Result<int> CrowdRenderer::add_mesh(const SkinnedMesh& mesh) {
+Result<int> CrowdRenderer::add_mesh(const SkinnedMesh& mesh, const MeshLodOptions& lod_options) {
   if (!initialized_) return Status::Error("add_mesh: renderer not initialised");
   const size_t n = mesh.positions.size();
   if (n == 0 || mesh.indices.empty() || mesh.indices.size() % 3 != 0) {
@@ -96,9 +96,30 @@ Result<int> CrowdRenderer::add_mesh(const SkinnedMesh& mesh) {
   }
   gpu.radius_m = radius * kCullRadiusMargin;
   gpu.shadow_radius_m = std::max(low_radius * 1.6f, 0.15f);
-  gpu.num_indices = static_cast<GLsizei>(mesh.indices.size());
+  std::vector<uint32_t> wound;
+  gpu.cull_back_faces = rewind_to_normals(mesh, &wound);
+  // Simplification keeps the winding, so the culling decided on the full mesh holds at every level.
+  Result<MeshLodChain> chain = build_mesh_lods(mesh, wound, lod_options);
+  if (!chain.ok()) return Status::Error("add_mesh: " + chain.message());
+  // One buffer of each: level l's copy of the vertices (with its own normals) follows level
+  // l - 1's, and its indices, offset to that copy, follow level l - 1's.
   std::vector<uint32_t> indices;
-  gpu.cull_back_faces = rewind_to_normals(mesh, &indices);
+  gpu.num_lods = std::min(chain->num_levels(), kMaxMeshLods);
+  vertices.resize(n * gpu.num_lods);
+  for (int l = 0; l < gpu.num_lods; ++l) {
+    const MeshLodLevel& level = chain->levels[l];
+    gpu.lod_first[l] = static_cast<GLsizei>(indices.size());
+    gpu.lod_count[l] = static_cast<GLsizei>(level.indices.size());
+    gpu.lod_error_m[l] = level.error_m;
+    gpu.lod_inflate_m[l] = level.inflate_m;
+    const auto first_vertex = static_cast<uint32_t>(n * l);
+    for (uint32_t i : level.indices) indices.push_back(first_vertex + i);
+    if (l == 0) continue;
+    for (size_t i = 0; i < n; ++i) {
+      vertices[first_vertex + i] = vertices[i];
+      if (level.normals.size() == n) vertices[first_vertex + i].normal = level.normals[i];
+    }
+  }
 
   glGenVertexArrays(1, &gpu.vao);
   glGenBuffers(1, &gpu.vertex_buffer);
@@ -136,8 +157,8 @@ Result<int> CrowdRenderer::add_mesh(const SkinnedMesh& mesh) {
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 
   meshes_.push_back(gpu);
-  mesh_first_.resize(meshes_.size());
-  mesh_count_.resize(meshes_.size());
+  bucket_first_.resize(meshes_.size() * kMaxMeshLods);
+  bucket_count_.resize(meshes_.size() * kMaxMeshLods);
   return static_cast<int>(meshes_.size()) - 1;
 }
 

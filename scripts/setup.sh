@@ -12,7 +12,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libglfw3-dev libimgui-dev libgl-dev libopengl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libgles-dev
-  libcli11-dev libtbb-dev librecast-dev
+  libcli11-dev libtbb-dev librecast-dev libmeshoptimizer-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth ffmpeg jq gnuplot-nox
   clang libclang-rt-14-dev

@@ -2,6 +2,9 @@
 // texels per column-major mat4); the instance attribute says where this agent's palette starts.
 
 uniform samplerBuffer u_palette;  // texture unit 0
+// A lighter mesh level is pushed out along the bind-pose normals by this much [m], so that it
+// keeps the full mesh's volume (render/mesh_lod.h); 0 for the full mesh.
+uniform float u_lod_inflate_m;
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -24,7 +27,7 @@ mat4 palette_matrix(uint joint) {
 void main() {
   mat4 skin = a_weights.x * palette_matrix(a_joints.x) + a_weights.y * palette_matrix(a_joints.y) +
               a_weights.z * palette_matrix(a_joints.z) + a_weights.w * palette_matrix(a_joints.w);
-  vec4 world = skin * vec4(a_position, 1.0);
+  vec4 world = skin * vec4(a_position + a_normal * u_lod_inflate_m, 1.0);
   v_world_pos = world.xyz;
   // Palettes are rigid (or uniformly scaled) per joint, so the blended upper 3x3 is a good enough
   // normal matrix; the fragment shader renormalises.

@@ -215,6 +215,39 @@ TEST(BenchCli, RenderStagesAreTimed) {
     ASSERT_TRUE(j["timing_ms"][stage].is_object()) << stage;
     EXPECT_GT(j["timing_ms"][stage]["median"].get<double>(), 0.0) << stage;
   }
+  // What was drawn: the mesh's levels (lighter and lighter), the agents per level and the
+  // triangles they add up to.
+  const nlohmann::json& render = j["render"];
+  ASSERT_TRUE(render.is_object());
+  EXPECT_TRUE(render["mesh_lod"].get<bool>());
+  const nlohmann::json& levels = render["mesh_levels"];
+  ASSERT_GE(levels.size(), 2u);
+  ASSERT_EQ(render["agents_per_level"].size(), levels.size());
+  double agents = 0.0, triangles = 0.0;
+  for (size_t l = 0; l < levels.size(); ++l) {
+    if (l > 0) {
+      EXPECT_LT(levels[l]["triangles"].get<int>(), levels[l - 1]["triangles"].get<int>());
+    }
+    agents += render["agents_per_level"][l].get<double>();
+    triangles += render["agents_per_level"][l].get<double>() * levels[l]["triangles"].get<int>();
+  }
+  EXPECT_GT(agents, 0.0);
+  EXPECT_LE(agents, 8.0);
+  EXPECT_NEAR(render["agent_triangles_per_frame"].get<double>(), triangles, 1e-6 * triangles);
+  EXPECT_GT(render["cpu_ms"]["median"].get<double>(), 0.0);
+
+  // --mesh-lod off: every agent with the full mesh.
+  GK_RUN_RENDER(off,
+                "bench --scenario crossing --agents 8 --frames 40 --render --size 320x180 "
+                "--mesh-lod off --json " +
+                    dir + "/bench_render_off.json");
+  std::ifstream in_off(dir + "/bench_render_off.json");
+  const nlohmann::json k = nlohmann::json::parse(in_off);
+  EXPECT_FALSE(k["render"]["mesh_lod"].get<bool>());
+  for (size_t l = 1; l < k["render"]["agents_per_level"].size(); ++l) {
+    EXPECT_EQ(k["render"]["agents_per_level"][l].get<double>(), 0.0) << l;
+  }
+  EXPECT_GT(k["render"]["agents_per_level"][0].get<double>(), 0.0);
 }
 
 }  // namespace

@@ -166,6 +166,89 @@ TEST_F(RendererTest, CrowdIsDrawnWhereProjectedAndNowhereElse) {
   EXPECT_GT(changed_inside, 20 * 200);  // each agent covers at least a few hundred pixels
 }
 
+TEST_F(RendererTest, MeshLodDrawsFarAgentsLighterAndKeepsTheCrowdsLook) {
+  const CrowdModel model = make_crowd_model();
+  Result<int> mesh = renderer_->add_mesh(model.mesh);
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  ASSERT_EQ(renderer_->num_mesh_lods(*mesh), kMaxMeshLods);
+  // Rows from 4 m in front of the eye to 140 m away: every level has its distance in this view.
+  camera_.target = glm::vec3(0.0f, 0.8f, 0.0f);
+  camera_.pitch_rad = 0.2f;
+  camera_.distance_m = 12.0f;
+  std::vector<AgentDraw> agents;
+  for (float z = 8.0f; z >= -130.0f; z -= 3.0f) {
+    for (float x = -6.0f; x <= 6.0f; x += 2.0f) {
+      AgentDraw a;
+      a.position = glm::vec3(x + 0.5f * std::sin(z), 0.0f, z);
+      a.tint = glm::vec3(0.9f, 0.5f + 0.02f * z, 0.4f);
+      a.mesh = *mesh;
+      agents.push_back(a);
+    }
+  }
+  const int n = static_cast<int>(agents.size());
+  std::vector<glm::mat4> palettes(static_cast<size_t>(n) * model.joints_per_agent);
+  for (int i = 0; i < n; ++i) {
+    ASSERT_NO_FATAL_FAILURE(model.palette(
+        agents[i].position, 0.4f * i, 0.05f * i,
+        std::span(palettes).subspan(i * model.joints_per_agent, model.joints_per_agent)));
+  }
+  ASSERT_TRUE(renderer_->upload_palettes(palettes, model.joints_per_agent).ok());
+
+  FrameCapture empty, full, lod;
+  ASSERT_NO_FATAL_FAILURE(render({}, &empty));
+  renderer_->settings().mesh_lod = false;
+  ASSERT_NO_FATAL_FAILURE(render(agents, &full));
+  const RenderStats full_stats = renderer_->stats();
+  renderer_->settings().mesh_lod = true;
+  ASSERT_NO_FATAL_FAILURE(render(agents, &lod));
+  const RenderStats lod_stats = renderer_->stats();
+  const std::string dir = scratch_dir("render");
+  ASSERT_TRUE(lod.save_png(dir + "/mesh_lod_on.png").ok());
+  ASSERT_TRUE(full.save_png(dir + "/mesh_lod_off.png").ok());
+
+  // Without LOD every visible agent has the full mesh; with it the near rows keep it, the far
+  // rows get the lightest level, and far fewer triangles are drawn.
+  EXPECT_EQ(full_stats.agents_per_lod[0], full_stats.agents_visible);
+  EXPECT_EQ(full_stats.agent_triangles,
+            static_cast<int64_t>(full_stats.agents_visible) * model.mesh.num_triangles());
+  EXPECT_EQ(lod_stats.agents_visible, full_stats.agents_visible);
+  EXPECT_GT(lod_stats.agents_per_lod[0], 0);
+  EXPECT_GT(lod_stats.agents_per_lod[kMaxMeshLods - 1], 0);
+  int64_t expected_triangles = 0;
+  for (int l = 0; l < kMaxMeshLods; ++l) {
+    expected_triangles +=
+        static_cast<int64_t>(lod_stats.agents_per_lod[l]) * renderer_->mesh_lod_triangles(*mesh, l);
+  }
+  EXPECT_EQ(lod_stats.agent_triangles, expected_triangles);
+  EXPECT_LT(lod_stats.agent_triangles * 2, full_stats.agent_triangles);
+  // Each levels' draw is one instanced call (plus ground, walls... none here, and shadows).
+  int levels_used = 0;
+  for (int count : lod_stats.agents_per_lod) levels_used += count > 0;
+  EXPECT_EQ(lod_stats.skinned_draw_calls, levels_used);
+
+  // The crowd is still there, agent by agent, and covers the same area of the image.
+  for (const AgentDraw& a : agents) {
+    const ProjectedPoint p =
+        camera_.project(a.position + glm::vec3(0.0f, model.mid_height_m, 0.0f), viewport());
+    const int x = static_cast<int>(p.pixel.x), y = static_cast<int>(p.pixel.y);
+    if (!p.in_front || x < 0 || y < 0 || x >= kWidth || y >= kHeight) continue;
+    EXPECT_GT(pixel_difference(lod.pixel(x, y), empty.pixel(x, y)), 30)
+        << "no agent drawn at " << x << "," << y << " for agent at " << a.position.x << ","
+        << a.position.z;
+  }
+  // Levels change edges by less than a pixel (and the lighter ones are pushed out to the full
+  // mesh's volume): the crowd covers the same pixels within a few per cent.
+  int covered_full = 0, covered_lod = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      covered_full += pixel_difference(full.pixel(x, y), empty.pixel(x, y)) > 8;
+      covered_lod += pixel_difference(lod.pixel(x, y), empty.pixel(x, y)) > 8;
+    }
+  }
+  EXPECT_GT(covered_full, 5000);
+  EXPECT_NEAR(covered_lod, covered_full, 0.05 * covered_full);
+}
+
 TEST_F(RendererTest, SkinningRotatesSecondJoint) {
   Result<int> mesh = renderer_->add_mesh(make_two_bone_column());
   ASSERT_TRUE(mesh.ok()) << mesh.message();
