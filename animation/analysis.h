@@ -50,7 +50,8 @@ struct ClipAnalysis {
   SlideStats floor;  // foot-slide metrics of the clip played with its own root motion
   // Ground under the feet, fitted to the lowest toe heights: y = ground_y0_m + ground_slope_m_s *
   // t. Mocap floors are rarely level (the CMU walk rises 5 cm over 2.6 s); contacts are measured
-  // against this line rather than one global minimum.
+  // against this line rather than one global minimum, and then, in a take, against the floor of
+  // each stance (a tilted floor is level under a planted foot, which a line in time is not).
   float ground_y0_m = 0.0f;
   float ground_slope_m_s = 0.0f;
 };
