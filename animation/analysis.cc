@@ -280,6 +280,22 @@ glm::vec3 in_place_travel(const Tracks& tr, const Clip& clip) {
   return travel;
 }
 
+// How fast the hips move along their path [m/s]: sampled every half second (about a step, so the
+// pelvis's sway within a step is left out), path length over time; 0 for a take shorter than
+// that.
+float path_speed(const std::vector<glm::vec3>& root, float fps) {
+  const int n = static_cast<int>(root.size());
+  const int step = std::max(1, static_cast<int>(std::lround(0.5f * fps)));
+  float len = 0.0f;
+  int f = 0;
+  for (; f + step < n; f += step) {
+    glm::vec3 d = root[f + step] - root[f];
+    d.y = 0.0f;
+    len += glm::length(d);
+  }
+  return f > 0 ? len * fps / f : 0.0f;
+}
+
 // One foot's contact frames: its heel, ankle, ball or toe tip nearly still over the ground and low.
 // "Still" is relative to the clip's own travel speed (a planted point moves slower than half the
 // body's speed; a swing foot moves about twice it); "low" is relative to the point's own lowest
@@ -512,7 +528,12 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
   for (int s = 0; s < 2; ++s) a.contacts[s] = to_intervals(contact[s], clip.fps, clip.loops);
   merge_unalternated(a.contacts, a.duration_s, clip.loops);
 
+  // A take's speed is the one along its path: a take that turns or stops covers more ground than
+  // its net displacement says (the still threshold above stays with the net travel).
   a.native_speed_m_s = glm::length(travel_vel);
+  if (!clip.loops && !a.in_place) {
+    a.native_speed_m_s = std::max(a.native_speed_m_s, path_speed(tr.root, clip.fps));
+  }
   a.direction_rad =
       a.native_speed_m_s > 0.0f ? wrap_angle(heading_of(travel_vel) - heading_of(facing)) : 0.0f;
 

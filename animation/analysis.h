@@ -41,6 +41,8 @@ struct ClipAnalysis {
   int num_frames = 0;
   float duration_s = 0.0f;
   bool in_place = false;  // no horizontal root motion: speed inferred from the stance foot
+  // [m/s] loops: per loop; takes: along the root's path (sampled every 0.5 s), which a take that
+  // turns or stops covers faster than its net displacement; in place: from the stance foot
   float native_speed_m_s = 0.0f;
   float direction_rad = 0.0f;  // travel direction relative to the character's facing (0 = forward)
   TimeInterval cycle;          // one gait cycle (the loop points of a one-stride loop)
