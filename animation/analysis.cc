@@ -29,6 +29,7 @@ struct Tracks {
   // with the ball lowest), the first to touch at a heel strike while the ankle still rolls
   // forward. Without a tip, the ball stands in for it.
   std::vector<glm::vec3> tip[2], heel[2];
+  std::vector<glm::mat4> ankle_m[2];  // the ankles' model transforms (for the heels)
 };
 
 Tracks track_clip_frames(const Clip& clip, const Skeleton& sk) {
@@ -61,19 +62,30 @@ Tracks track_clip_frames(const Clip& clip, const Skeleton& sk) {
       ankle_m[s].push_back(model[sk.ankle(side)]);
     }
   }
+  for (int s = 0; s < 2; ++s) t.ankle_m[s] = std::move(ankle_m[s]);
+  return t;
+}
+
+// The heel points: fixed to the ankle where the floor was under it on the frame its ball is lowest
+// over the fitted ground (y = ground_y0 + slope * t): the lowest ball over the whole take would be
+// wherever a sloping or tilted floor is lowest, flat foot or not.
+void add_heels(Tracks* t, float fps, float ground_y0, float slope) {
   for (int s = 0; s < 2; ++s) {
-    const int n = clip.num_frames;
+    const int n = static_cast<int>(t->toe[s].size());
+    auto above = [&](int f) { return t->toe[s][f].y - (ground_y0 + slope * (f / fps)); };
     int flat = 0;
     for (int f = 1; f < n; ++f) {
-      if (t.toe[s][f].y < t.toe[s][flat].y) flat = f;
+      if (above(f) < above(flat)) flat = f;
     }
-    const glm::vec3 a = t.ankle[s][flat];
-    const float floor_y = std::min(t.toe[s][flat].y, t.tip[s][flat].y);
-    const glm::vec3 heel_local =
-        glm::vec3(glm::inverse(ankle_m[s][flat]) * glm::vec4(a.x, std::min(floor_y, a.y), a.z, 1.0f));
-    for (int f = 0; f < n; ++f) t.heel[s].push_back(glm::vec3(ankle_m[s][f] * glm::vec4(heel_local, 1.0f)));
+    const glm::vec3 a = t->ankle[s][flat];
+    const float floor_y = std::min(t->toe[s][flat].y, t->tip[s][flat].y);
+    const glm::vec3 heel_local = glm::vec3(glm::inverse(t->ankle_m[s][flat]) *
+                                           glm::vec4(a.x, std::min(floor_y, a.y), a.z, 1.0f));
+    t->heel[s].clear();
+    for (int f = 0; f < n; ++f) {
+      t->heel[s].push_back(glm::vec3(t->ankle_m[s][f] * glm::vec4(heel_local, 1.0f)));
+    }
   }
-  return t;
 }
 
 // Fits y = a + b t to the lowest toe height of each ~0.4 s window (the ground under the stance
@@ -268,13 +280,30 @@ glm::vec3 in_place_travel(const Tracks& tr, const Clip& clip) {
   return travel;
 }
 
+// How fast the hips move along their path [m/s]: sampled every half second (about a step, so the
+// pelvis's sway within a step is left out), path length over time; 0 for a take shorter than
+// that.
+float path_speed(const std::vector<glm::vec3>& root, float fps) {
+  const int n = static_cast<int>(root.size());
+  const int step = std::max(1, static_cast<int>(std::lround(0.5f * fps)));
+  float len = 0.0f;
+  int f = 0;
+  for (; f + step < n; f += step) {
+    glm::vec3 d = root[f + step] - root[f];
+    d.y = 0.0f;
+    len += glm::length(d);
+  }
+  return f > 0 ? len * fps / f : 0.0f;
+}
+
 // One foot's contact frames: its heel, ankle, ball or toe tip nearly still over the ground and low.
 // "Still" is relative to the clip's own travel speed (a planted point moves slower than half the
 // body's speed; a swing foot moves about twice it); "low" is relative to the point's own lowest
 // heights over the fitted ground (a gate well below the swing's height, never the judge alone).
+// `floor`: per frame, the floor under this foot (stance_floor), or null for the fitted line.
 void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalysis& a,
                      const glm::vec3& travel_vel, const ContactThresholds& th,
-                     std::vector<uint8_t>* out) {
+                     const std::vector<float>* floor, std::vector<uint8_t>* out) {
   const int n = static_cast<int>(tr.root.size());
   const int k = velocity_half_window(clip.fps);
   const float still =
@@ -288,7 +317,7 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
     std::vector<uint8_t> backward(n, 0);
     const float travel = glm::length(travel_vel);
     for (int f = 0; f < n; ++f) {
-      h[f] = p[f].y - (a.ground_y0_m + a.ground_slope_m_s * (f / clip.fps));
+      h[f] = p[f].y - (floor ? (*floor)[f] : a.ground_y0_m + a.ground_slope_m_s * (f / clip.fps));
       glm::vec3 v = track_velocity(p, tr, f, k, clip, a.in_place);
       // In place, a stance foot is carried backward under the hips and a swing foot forward: the
       // sign holds even for keyframed clips whose stance foot is not ground-consistent.
@@ -310,6 +339,87 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
     for (int f = 0; f < n; ++f) down[j][f] = (speed[f] < still || backward[f]) && h[f] <= gate;
   }
   for (int f = 0; f < n; ++f) (*out)[f] = down[0][f] || down[1][f] || down[2][f] || down[3][f];
+}
+
+// Stances of one foot: its runs of contact frames.
+struct Stance {
+  int first, last;
+};
+std::vector<Stance> stances_of(const std::vector<uint8_t>& contact) {
+  std::vector<Stance> out;
+  const int n = static_cast<int>(contact.size());
+  for (int f = 0; f < n;) {
+    if (!contact[f]) {
+      ++f;
+      continue;
+    }
+    Stance st{f, f};
+    while (f < n && contact[f]) st.last = f++;
+    out.push_back(st);
+  }
+  return out;
+}
+
+// How fast the floor drifts up over time [m/s]: a planted ball keeps its height on a tilted floor
+// but rises with a drifting one, so the median over stances of the ball's height slope in the
+// middle half of each stance (flat foot; heel strike and toe-off left out). 0 without stances.
+float floor_drift(const std::vector<glm::vec3>* toe, const std::vector<uint8_t>* contact,
+                  float fps) {
+  std::vector<float> slopes;
+  for (int s = 0; s < 2; ++s) {
+    for (const Stance& st : stances_of(contact[s])) {
+      const int len = st.last - st.first + 1;
+      const int f0 = st.first + len / 4, f1 = st.last - len / 4;
+      if (f1 - f0 < 3) continue;
+      double mt = 0, my = 0;
+      for (int f = f0; f <= f1; ++f) {
+        mt += f / fps;
+        my += toe[s][f].y;
+      }
+      mt /= f1 - f0 + 1;
+      my /= f1 - f0 + 1;
+      double num = 0, den = 0;
+      for (int f = f0; f <= f1; ++f) {
+        num += (f / fps - mt) * (toe[s][f].y - my);
+        den += (f / fps - mt) * (f / fps - mt);
+      }
+      if (den > 0) slopes.push_back(static_cast<float>(num / den));
+    }
+  }
+  return slopes.empty() ? 0.0f : percentile(slopes, 0.5);
+}
+
+// The floor under one foot, fitted per stance: where its ball stood (lowest, the floor's drift
+// over time taken out) in each of its contacts, held over the contact and taken linearly from one
+// stance to the next over the swing; the drift added back. A floor that tilts is then level under
+// every planted foot, which one line in time is not (on a tilted floor the body moves on while a
+// planted foot stays put). Empty when the foot has no contact.
+std::vector<float> stance_floor(const std::vector<glm::vec3>& toe,
+                                const std::vector<uint8_t>& contact, float drift_m_s, float fps) {
+  const int n = static_cast<int>(contact.size());
+  const std::vector<Stance> stances = stances_of(contact);
+  if (stances.empty()) return {};
+  std::vector<float> level(stances.size());
+  for (size_t i = 0; i < stances.size(); ++i) {
+    level[i] = 1e30f;
+    for (int f = stances[i].first; f <= stances[i].last; ++f) {
+      level[i] = std::min(level[i], toe[f].y - drift_m_s * (f / fps));
+    }
+  }
+  std::vector<float> floor(n);
+  for (int f = 0; f <= stances.front().last; ++f) floor[f] = level.front();
+  for (size_t i = 0; i < stances.size(); ++i) {
+    const Stance& st = stances[i];
+    for (int f = st.first; f <= st.last; ++f) floor[f] = level[i];
+    const int end = i + 1 < stances.size() ? stances[i + 1].first : n;
+    for (int f = st.last + 1; f < end; ++f) {
+      floor[f] = i + 1 < stances.size()
+                     ? level[i] + (level[i + 1] - level[i]) * (f - st.last) / (end - st.last)
+                     : level[i];
+    }
+  }
+  for (int f = 0; f < n; ++f) floor[f] += drift_m_s * (f / fps);
+  return floor;
 }
 
 // In a walk or a run the feet take turns: between two contacts of one foot the other foot lands.
@@ -374,7 +484,7 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
   a.phase.assign(clip.num_frames, 0.0f);
   if (clip.num_frames < 2 || !sk.has_locomotion_roles()) return a;
 
-  const Tracks tr = track_clip_frames(clip, sk);
+  Tracks tr = track_clip_frames(clip, sk);
   const int n = clip.num_frames;
   const float span_s = (n - 1) / clip.fps;
 
@@ -396,18 +506,34 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
   // gate relative to the foot's own low heights keeps a slow swing foot out.
   fit_ground(tr, clip.fps, &a.ground_y0_m, &a.ground_slope_m_s);
   if (clip.loops) a.ground_slope_m_s = 0.0f;  // a loop returns to where it started
+  add_heels(&tr, clip.fps, a.ground_y0_m, a.ground_slope_m_s);
   const glm::vec3 travel_vel = a.in_place ? in_place_travel(tr, clip) : root_vel;
   std::vector<uint8_t> contact[2];
+  const int min_frames = std::max(2, static_cast<int>(std::lround(th.min_duration_s * clip.fps)));
   for (int s = 0; s < 2; ++s) {
-    detect_contacts(tr, s, clip, a, travel_vel, th, &contact[s]);
-    filter_runs(contact[s],
-                std::max(2, static_cast<int>(std::lround(th.min_duration_s * clip.fps))),
-                clip.loops);
-    a.contacts[s] = to_intervals(contact[s], clip.fps, clip.loops);
+    detect_contacts(tr, s, clip, a, travel_vel, th, nullptr, &contact[s]);
+    filter_runs(contact[s], min_frames, clip.loops);
   }
+  // A take's floor may tilt or drift: heights again, over the floor of each stance just found
+  // (a loop's floor is level: it returns to where it started).
+  if (!clip.loops) {
+    const float drift = floor_drift(tr.toe, contact, clip.fps);
+    for (int s = 0; s < 2; ++s) {
+      const std::vector<float> floor = stance_floor(tr.toe[s], contact[s], drift, clip.fps);
+      if (floor.empty()) continue;
+      detect_contacts(tr, s, clip, a, travel_vel, th, &floor, &contact[s]);
+      filter_runs(contact[s], min_frames, clip.loops);
+    }
+  }
+  for (int s = 0; s < 2; ++s) a.contacts[s] = to_intervals(contact[s], clip.fps, clip.loops);
   merge_unalternated(a.contacts, a.duration_s, clip.loops);
 
+  // A take's speed is the one along its path: a take that turns or stops covers more ground than
+  // its net displacement says (the still threshold above stays with the net travel).
   a.native_speed_m_s = glm::length(travel_vel);
+  if (!clip.loops && !a.in_place) {
+    a.native_speed_m_s = std::max(a.native_speed_m_s, path_speed(tr.root, clip.fps));
+  }
   a.direction_rad =
       a.native_speed_m_s > 0.0f ? wrap_angle(heading_of(travel_vel) - heading_of(facing)) : 0.0f;
 

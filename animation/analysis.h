@@ -41,6 +41,8 @@ struct ClipAnalysis {
   int num_frames = 0;
   float duration_s = 0.0f;
   bool in_place = false;  // no horizontal root motion: speed inferred from the stance foot
+  // [m/s] loops: per loop; takes: along the root's path (sampled every 0.5 s), which a take that
+  // turns or stops covers faster than its net displacement; in place: from the stance foot
   float native_speed_m_s = 0.0f;
   float direction_rad = 0.0f;  // travel direction relative to the character's facing (0 = forward)
   TimeInterval cycle;          // one gait cycle (the loop points of a one-stride loop)
@@ -50,7 +52,8 @@ struct ClipAnalysis {
   SlideStats floor;  // foot-slide metrics of the clip played with its own root motion
   // Ground under the feet, fitted to the lowest toe heights: y = ground_y0_m + ground_slope_m_s *
   // t. Mocap floors are rarely level (the CMU walk rises 5 cm over 2.6 s); contacts are measured
-  // against this line rather than one global minimum.
+  // against this line rather than one global minimum, and then, in a take, against the floor of
+  // each stance (a tilted floor is level under a planted foot, which a line in time is not).
   float ground_y0_m = 0.0f;
   float ground_slope_m_s = 0.0f;
 };

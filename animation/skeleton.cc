@@ -96,7 +96,84 @@ std::string compact(std::string_view s) {
   return out;
 }
 
-NameInfo classify(std::string_view raw) {
+// The words of a name, lower case: split at anything but letters and digits and where camel case
+// starts a word ("Bip01 L Thigh" -> bip01 l thigh, "J_Bip_L_UpperLeg" -> j bip l upper leg,
+// "LHipJoint" -> l hip joint); digits stay with the word before them ("Toe0", "Spine1").
+std::vector<std::string> words_of(std::string_view raw) {
+  std::vector<std::string> words;
+  std::string cur;
+  auto flush = [&] {
+    if (!cur.empty()) words.push_back(lower(cur));
+    cur.clear();
+  };
+  for (size_t i = 0; i < raw.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(raw[i]);
+    if (!std::isalnum(c)) {
+      flush();
+      continue;
+    }
+    const bool upper = std::isupper(c);
+    const unsigned char prev = i > 0 ? static_cast<unsigned char>(raw[i - 1]) : 0;
+    const unsigned char next = i + 1 < raw.size() ? static_cast<unsigned char>(raw[i + 1]) : 0;
+    // A capital after a lower-case letter or digit starts a word, and so does the last capital
+    // of a run followed by lower case ("LHip" -> L, Hip).
+    if (upper && !cur.empty() &&
+        (std::islower(prev) || std::isdigit(prev) || (std::isupper(prev) && std::islower(next)))) {
+      flush();
+    }
+    cur += static_cast<char>(c);
+  }
+  flush();
+  return words;
+}
+
+// Names the plain rules below do not read, word by word: a side word anywhere ("Bip01 L Thigh",
+// "CC_Base_L_Calf", "J_Bip_L_UpperLeg"; "C" marks the middle in VRM), and the body-part word
+// after a rig prefix (leading words with digits or of at most three letters, or "base":
+// "Bip01", "J_Bip", "CC_Base"). A part word must end the name ("thigh_twist_01_l" is no thigh).
+NameInfo classify_by_words(std::string_view raw) {
+  NameInfo info;
+  std::vector<std::string> words = words_of(raw);
+  std::vector<std::string> rest;
+  int sides = 0;
+  for (const std::string& w : words) {
+    if (w == "l" || w == "left") {
+      info.side = NameSide::kLeft;
+      ++sides;
+    } else if (w == "r" || w == "right") {
+      info.side = NameSide::kRight;
+      ++sides;
+    } else if (w != "c" && w != "m" && w != "mid" && w != "center" && w != "centre") {
+      rest.push_back(w);
+    }
+  }
+  if (sides > 1) return {};
+  auto droppable = [](const std::string& w) {
+    return w.size() <= 3 || w == "base" || std::any_of(w.begin(), w.end(), [](char c) {
+             return std::isdigit(static_cast<unsigned char>(c));
+           });
+  };
+  for (size_t k = 0; k < rest.size(); ++k) {
+    std::string base;
+    for (size_t i = k; i < rest.size(); ++i) base += rest[i];
+    while (!base.empty() && std::isdigit(static_cast<unsigned char>(base.back()))) base.pop_back();
+    Part p = part_of_base(base, info.side != NameSide::kNone);
+    if (p == Part::kNone && info.side == NameSide::kNone) {
+      p = part_of_base(base, true);  // a leg word without a side: the side comes from geometry
+      if (p != Part::kThigh && p != Part::kShin && p != Part::kFoot && p != Part::kToe) {
+        p = Part::kNone;
+      }
+    }
+    if (p != Part::kNone) {
+      info.part = p;
+      return info;
+    }
+    if (!droppable(rest[k])) break;
+  }
+  return {};
+}
+
+NameInfo classify_plain(std::string_view raw) {
   std::string n = lower(raw);
   // Namespaces (mixamorig:, rig|) and Rigify's deform prefix say nothing about the body part.
   if (size_t p = n.find_last_of(":|"); p != std::string::npos) n = n.substr(p + 1);
@@ -165,6 +242,12 @@ NameInfo classify(std::string_view raw) {
     const Part p = part_of_base(word, true);
     if (p == Part::kThigh || p == Part::kShin || p == Part::kFoot || p == Part::kToe) info.part = p;
   }
+  return info;
+}
+
+NameInfo classify(std::string_view raw) {
+  NameInfo info = classify_plain(raw);
+  if (info.part == Part::kNone) info = classify_by_words(raw);
   return info;
 }
 
@@ -275,6 +358,8 @@ void detect_leg(Skeleton* s, const std::vector<NameInfo>& info, const std::vecto
                            glm::length(pos[knee] - pos[hip]));
   }
   if (ankle >= 0) toe = nearest_below(*s, info, Part::kToe, side, ankle);
+  // Below an ankle, a foot is the toe (SMPL: L_Knee -> L_Ankle -> L_Foot).
+  if (ankle >= 0 && toe < 0) toe = nearest_below(*s, info, Part::kFoot, side, ankle);
   if (ankle >= 0 && toe < 0) {
     toe = ik_style_joint(*s, info, pos, Part::kToe, side, hip, ankle,
                          glm::length(pos[ankle] - pos[knee]));

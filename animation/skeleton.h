@@ -87,12 +87,14 @@ struct Skeleton {
 // Fills roles and spine_chain from the joint names, recognising CMU/cgspeed (LeftUpLeg/LeftLeg/
 // LeftFoot/LeftToeBase and LeftHip/LeftKnee/LeftAnkle/LeftToe), Rigify (DEF-thigh.L), Mixamo
 // (mixamorig:LeftUpLeg), Unreal (thigh_l/calf_l/foot_l/ball_l), ASF (lfemur/ltibia/lfoot/ltoes),
-// RobotExpressive (UpperLegL) and plain (l_hip, left_knee) names, with topology checks (a knee
-// must be below its hip, ...). A leg word without a side ("Foot.001") takes the side it stands on
-// in the rest pose (left at +x). IK-style rigs, whose feet (or toes) are not below the shins (or
-// feet) but hang from the root or the hips, are matched by the rest pose: the foot is the
-// same-side foot joint that sits a plausible shin length below the knee, nearest under it (the
-// loaders then re-parent it, attach_ik_feet). Unrecognised roles stay -1.
+// Unity (UpperLeg_L), RobotExpressive (UpperLegL) and plain (l_hip, left_knee) names, and word by
+// word names with a rig prefix and a side word anywhere (Bip01 L Thigh, J_Bip_L_UpperLeg,
+// CC_Base_L_Calf); a foot word below the ankle is the toe (SMPL's L_Ankle -> L_Foot). With
+// topology checks (a knee must be below its hip, ...). A leg word without a side ("Foot.001") takes
+// the side it stands on in the rest pose (left at +x). IK-style rigs, whose feet (or toes) are not
+// below the shins (or feet) but hang from the root or the hips, are matched by the rest pose: the
+// foot is the same-side foot joint that sits a plausible shin length below the knee, nearest under
+// it (the loaders then re-parent it, attach_ik_feet). Unrecognised roles stay -1.
 void detect_joint_roles(Skeleton* skeleton);
 
 // The locomotion roles (those of has_locomotion_roles) the skeleton lacks, comma-separated

@@ -178,6 +178,28 @@ TEST(Analysis, SubjectSixteenSteadyTakes) {
   }
 }
 
+// Every subject-16 take, steady or not, moves at PROVENANCE.md's average root speed (path length
+// over 0.5 s samples / time) within 5%: a take that turns 90 degrees or stops covers more ground
+// than its net displacement (16_17: 0.71 m/s net against 0.94 along its path).
+TEST(Analysis, EveryTakeMovesAtItsSpeedAlongItsPath) {
+  struct Take {
+    const char* file;
+    float speed_m_s;  // PROVENANCE.md "Average root speed"
+  };
+  for (const Take& t : {Take{"clips/bvh/more/cmu_16_11_walk_veer_left.bvh", 0.96f},
+                        Take{"clips/bvh/more/cmu_16_15_walk_mrl30.bvh", 1.17f},
+                        Take{"clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh", 0.94f},
+                        Take{"clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh", 1.73f},
+                        Take{"clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh", 1.03f},
+                        Take{"clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh", 0.86f},
+                        Take{"clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh", 2.86f},
+                        Take{"clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh", 1.50f}}) {
+    GK_REQUIRE_DATA(t.file);
+    const Loaded l = load_and_analyze(t.file);
+    EXPECT_NEAR(l.analysis.native_speed_m_s, t.speed_m_s, 0.05f * t.speed_m_s) << t.file;
+  }
+}
+
 TEST(FootMetrics, SlideOfAKnownTrack) {
   // A foot down for 10 frames at 60 Hz creeping 1 mm per frame along x, then lifted 10 cm:
   // slide 6 cm/s on each of the 9 contact pairs, one interval of 9 mm drift.
