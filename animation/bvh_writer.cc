@@ -59,29 +59,8 @@ std::string format_bvh(const Skeleton& sk, const Clip& clip, const BvhWriteOptio
   // Depth-first in joint order: a skeleton's joints are topological, and a joint's subtree
   // closes before the next joint that is not below it.
   std::vector<int> open;  // joints whose braces are open
-  for (int j = 0; j < nj; ++j) {
-    while (!open.empty() && open.back() != sk.parents[j]) {
-      const int k = open.back();
-      open.pop_back();
-      const std::string pad(open.size() * 2, ' ');
-      if (children_left[k] == 0 && k < static_cast<int>(sk.end_sites.size())) {
-        const glm::vec3 e = sk.end_sites[k] * u;
-        out += pad + "  End Site\n" + pad + "  {\n" + pad;
-        append(&out, "    OFFSET %.9g %.9g %.9g\n", e.x, e.y, e.z);
-        out += pad + "  }\n";
-      }
-      out += pad + "}\n";
-    }
-    const std::string pad(open.size() * 2, ' ');
-    out += pad + (sk.parents[j] < 0 ? "ROOT " : "JOINT ") + sk.names[j] + "\n" + pad + "{\n";
-    const glm::vec3 o = sk.rest_translations[j] * u;
-    append(&out, (pad + "  OFFSET %.9g %.9g %.9g\n").c_str(), o.x, o.y, o.z);
-    out += pad +
-           (has_positions(j) ? "  CHANNELS 6 Xposition Yposition Zposition " : "  CHANNELS 3 ") +
-           "Zrotation Yrotation Xrotation\n";
-    open.push_back(j);
-  }
-  while (!open.empty()) {
+  // Closes the innermost open joint (with its End Site when it is a leaf that has one).
+  auto close_joint = [&] {
     const int k = open.back();
     open.pop_back();
     const std::string pad(open.size() * 2, ' ');
@@ -92,7 +71,19 @@ std::string format_bvh(const Skeleton& sk, const Clip& clip, const BvhWriteOptio
       out += pad + "  }\n";
     }
     out += pad + "}\n";
+  };
+  for (int j = 0; j < nj; ++j) {
+    while (!open.empty() && open.back() != sk.parents[j]) close_joint();
+    const std::string pad(open.size() * 2, ' ');
+    out += pad + (sk.parents[j] < 0 ? "ROOT " : "JOINT ") + sk.names[j] + "\n" + pad + "{\n";
+    const glm::vec3 o = sk.rest_translations[j] * u;
+    append(&out, (pad + "  OFFSET %.9g %.9g %.9g\n").c_str(), o.x, o.y, o.z);
+    out += pad +
+           (has_positions(j) ? "  CHANNELS 6 Xposition Yposition Zposition " : "  CHANNELS 3 ") +
+           "Zrotation Yrotation Xrotation\n";
+    open.push_back(j);
   }
+  while (!open.empty()) close_joint();
   const int n = clip.num_frames;
   const bool close_loop = clip.loops && n >= 2;
   char buf[96];
