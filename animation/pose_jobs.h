@@ -119,7 +119,8 @@ inline void prefetch_bytes(const void* p, size_t bytes, bool for_write = false) 
       __builtin_prefetch(c + off, 0);
     }
   }
-  if (bytes > 0) __builtin_prefetch(c + bytes - 1, for_write ? 1 : 0);
+  if (bytes > 0 && for_write) __builtin_prefetch(c + bytes - 1, 1);
+  if (bytes > 0 && !for_write) __builtin_prefetch(c + bytes - 1, 0);
 }
 
 // Small helpers used by several jobs and by analysis.
