@@ -176,6 +176,28 @@ std::vector<std::pair<int, int>> swing_runs(const std::vector<uint8_t>& down, bo
   return runs;
 }
 
+// Per frame of an in-place clip, each foot's toe and ankle in its model space.
+struct FootTracks {
+  std::vector<glm::vec3> toe[2], ankle[2];
+};
+FootTracks foot_tracks(const Clip& c, const Skeleton& sk) {
+  FootTracks t;
+  std::vector<glm::mat4> model(sk.num_joints());
+  for (int f = 0; f < c.num_frames; ++f) {
+    clip_frame_model(c, sk, f, model);
+    for (int s = 0; s < 2; ++s) {
+      t.toe[s].push_back(translation_of(model[sk.toe(static_cast<Side>(s))]));
+      t.ankle[s].push_back(translation_of(model[sk.ankle(static_cast<Side>(s))]));
+    }
+  }
+  return t;
+}
+
+// The in-place clip's feet move backward under the body at this velocity: added back, they stand.
+glm::vec3 travel_velocity(const LocomotionClip& lc) {
+  return lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
+}
+
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
   {
     // A walk has double support: both feet in contact on some frame (a run has a flight instead).
@@ -187,18 +209,10 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
   }
   const Clip& c = lc->clip;
   const int n = c.num_frames;
-  std::vector<glm::mat4> model(sk.num_joints());
-  std::vector<glm::vec3> toe[2], ankle[2];
-  for (int f = 0; f < n; ++f) {
-    clip_frame_model(c, sk, f, model);
-    for (int s = 0; s < 2; ++s) {
-      toe[s].push_back(translation_of(model[sk.toe(static_cast<Side>(s))]));
-      ankle[s].push_back(translation_of(model[sk.ankle(static_cast<Side>(s))]));
-    }
-  }
-  // The in-place clip's feet move backward under the body at the travel velocity; add it back.
-  const glm::vec3 travel =
-      lc->speed_m_s * glm::vec3(std::sin(lc->direction_rad), 0.0f, std::cos(lc->direction_rad));
+  const FootTracks tracks = foot_tracks(c, sk);
+  const std::vector<glm::vec3>(&toe)[2] = tracks.toe;
+  const std::vector<glm::vec3>(&ankle)[2] = tracks.ankle;
+  const glm::vec3 travel = travel_velocity(*lc);
   for (int s = 0; s < 2; ++s) {
     lc->plant[s].assign(n, 0);
     lc->hold[s].assign(n, 0);
@@ -912,14 +926,9 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     // clip, played at its native speed (the median over its swings).
     {
       const int nf = slow.clip.num_frames;
-      const glm::vec3 travel = slow.speed_m_s * glm::vec3(std::sin(slow.direction_rad), 0.0f,
-                                                          std::cos(slow.direction_rad));
-      std::vector<glm::mat4> model(sk.num_joints());
-      std::vector<glm::vec3> toe[2];
-      for (int f = 0; f < nf; ++f) {
-        clip_frame_model(slow.clip, sk, f, model);
-        for (int s = 0; s < 2; ++s) toe[s].push_back(translation_of(model[sk.toe(static_cast<Side>(s))]));
-      }
+      const glm::vec3 travel = travel_velocity(slow);
+      const FootTracks tracks = foot_tracks(slow.clip, sk);
+      const std::vector<glm::vec3>(&toe)[2] = tracks.toe;
       std::vector<float> speeds;
       for (int s = 0; s < 2; ++s) {
         for (const auto& [first, len] : swing_runs(slow.plant[s], slow.clip.loops)) {

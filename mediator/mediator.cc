@@ -238,8 +238,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
 }
 
 // LOD: the agent's phase, clip times and idle clock advance with the rate of its last plan, and
-// its root follows p as plan_agent's would (predicted with the filtered velocity, pulled onto p,
-// never more than kMaxRootOffset away). Clips, weights, facing and springs wait for its next plan.
+// its root follows p as the root pass's would (pulled_root). Clips, weights, facing and springs wait for its next plan.
 void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const glm::vec2& v_in,
                              float theta_in, float dt) {
   AnimationPlans& pl = plans_;
@@ -253,44 +252,28 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
   feedback_.positions[agent] = p;
   feedback_.velocities[agent] = v;
   feedback_.thetas[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];
-  if (params_.mode == MediatorMode::kApm) {
-    const glm::vec2 predicted = pl.root_xz[slot] + vel_[slot] * dt;
-    glm::vec2 root = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
-    const glm::vec2 off = root - p;
-    const float len = glm::length(off);
-    if (len > kMaxRootOffset) root = p + off * (kMaxRootOffset / len);
-    pl.root_xz[slot] = root;
-  } else {
-    pl.root_xz[slot] = p;
-  }
-  // The gait frequency of the planned blend, as plan_agent computes it.
+  pl.root_xz[slot] = params_.mode == MediatorMode::kApm
+                         ? pulled_root(pl.root_xz[slot], vel_[slot], p, dt)
+                         : p;
+  // The gait frequency of the planned blend, as the rate and phase pass takes it.
   const int16_t* lc = &pl.layer_clip[slot * kMaxBlendLayers];
   const float* lw = &pl.layer_weight[slot * kMaxBlendLayers];
   float* lt = &pl.layer_time_s[slot * kMaxBlendLayers];
-  float freq = 0.0f, gait_w = 0.0f;
-  for (int k = 0; k < kMaxBlendLayers; ++k) {
-    const LocomotionClip& clip = library_.clips[lc[k]];
-    if (clip.gait && lw[k] > 0.0f) {
-      freq += lw[k] / clip.cycle_s;
-      gait_w += lw[k];
-    }
-  }
-  if (gait_w > 0.0f) {
-    const float step = freq / gait_w * pl.playback_rate[slot] * dt;
+  const GaitFrequency gf = gait_frequency(library_, lc, lw);
+  if (gf.gait_weight > 0.0f) {
+    const float step = gf.cycles_per_s * pl.playback_rate[slot] * dt;
     pl.phase[slot] = std::fmod(pl.phase[slot] + step, 1.0f);
     lod_phase_advance_[slot] += step;
   }
   idle_time_[slot] += dt;
   lod_elapsed_s_[slot] += dt;
   for (int k = 0; k < kMaxBlendLayers; ++k) {
-    const LocomotionClip& clip = library_.clips[lc[k]];
-    lt[k] = clip.gait ? clip.time_at_phase(pl.phase[slot])
-                      : std::fmod(idle_time_[slot], std::max(clip.clip.duration_s(), 1e-3f));
+    lt[k] = layer_time(library_.clips[lc[k]], pl.phase[slot], idle_time_[slot]);
   }
 }
 
 // LOD: the step [s] a due agent is planned over: the time since its last plan. The phase, idle
-// clock and root are taken back to where that plan left them, so that plan_agent advances them
+// clock and root are taken back to where that plan left them, so that the passes advance them
 // once over the whole step (its root filter predicts from the last plan's root).
 float Mediator::lod_step(int slot, float dt) {
   if (plans_.fresh[slot] || lod_elapsed_s_[slot] <= 0.0f) return dt;

@@ -149,11 +149,7 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
     const glm::vec2 vel = vel_in[slot];
     glm::vec2 root_vel = vel;
     if (apm && !c.fresh[slot]) {
-      const glm::vec2 predicted = root_xz[slot] + vel * dt;
-      glm::vec2 root = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
-      const glm::vec2 off = root - p;
-      const float len = glm::length(off);
-      if (len > kMaxRootOffset) root = p + off * (kMaxRootOffset / len);
+      const glm::vec2 root = pulled_root(root_xz[slot], vel, p, dt);
       root_vel = (root - root_xz[slot]) / dt;
       root_xz[slot] = root;
     } else {
@@ -260,6 +256,19 @@ void weights_pass(const PassCrowd& c, std::span<const float> speed_m_s,
   });
 }
 
+GaitFrequency gait_frequency(const LocomotionLibrary& lib, const int16_t* lc, const float* lw) {
+  GaitFrequency out;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const LocomotionClip& clip = lib.clips[lc[k]];
+    if (clip.gait && lw[k] > 0.0f) {
+      out.cycles_per_s += lw[k] / clip.cycle_s;
+      out.gait_weight += lw[k];
+    }
+  }
+  if (out.gait_weight > 0.0f) out.cycles_per_s /= out.gait_weight;
+  return out;
+}
+
 void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
                      std::span<const float> cadence_scale, std::span<const float> lower_yaw,
@@ -274,20 +283,19 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     // the deliverable speed goes back to the simulator (feedback).
     const int16_t* lc = &layer_clip[slot * kMaxBlendLayers];
     const float* lw = &layer_weight[slot * kMaxBlendLayers];
-    float native = 0.0f, freq = 0.0f, gait_w = 0.0f;
+    const GaitFrequency gf = gait_frequency(lib, lc, lw);
+    const float freq = gf.cycles_per_s, gait_w = gf.gait_weight;
+    float native = 0.0f;
     glm::vec2 dir_sum(0.0f);
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       const LocomotionClip& clip = lib.clips[lc[k]];
       native += lw[k] * clip.speed_m_s;
       if (clip.gait && lw[k] > 0.0f) {
-        freq += lw[k] / clip.cycle_s;
-        gait_w += lw[k];
         dir_sum += lw[k] * glm::vec2(std::sin(clip.direction_rad), std::cos(clip.direction_rad));
       }
     }
     float rate = 1.0f;
     if (gait_w > 0.0f) {
-      freq /= gait_w;
       if (P.mode == MediatorMode::kNaive) {
         rate = 1.0f;
       } else if (native > 1e-3f) {
@@ -323,8 +331,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     const bool gait_votes = gait_w >= 0.25f;
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       const LocomotionClip& clip = lib.clips[lc[k]];
-      lt[k] = clip.gait ? clip.time_at_phase(phase[slot])
-                        : std::fmod(idle_time_s[slot], std::max(clip.clip.duration_s(), 1e-3f));
+      lt[k] = layer_time(clip, phase[slot], idle_time_s[slot]);
       if (lw[k] <= 0.0f) continue;
       const int nf = clip.clip.num_frames;
       auto wrap = [&](int i) {

@@ -15,6 +15,7 @@
 // work in a pass never touches another agent's data, so the passes' results do not depend on the
 // order or the threads. Nothing here allocates.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -63,6 +64,33 @@ inline bool sane_input(const glm::vec2& p, const glm::vec2& v, float theta) {
   return finite2(v) && !(glm::length(v) > kAbsurdSpeed) && usable_position(p) &&
          std::isfinite(theta);
 }
+// The drawn root one step of dt [s] on: predicted from `root` with the filtered velocity and
+// pulled onto the simulator's p, never more than kMaxRootOffset from it.
+inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const glm::vec2& p,
+                             float dt) {
+  const glm::vec2 predicted = root + vel * dt;
+  glm::vec2 out = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
+  const glm::vec2 off = out - p;
+  const float len = glm::length(off);
+  if (len > kMaxRootOffset) out = p + off * (kMaxRootOffset / len);
+  return out;
+}
+
+// A layer's clip time: a gait clip's at the shared gait phase, a standing clip's on its clock.
+inline float layer_time(const LocomotionClip& clip, float phase, float idle_time_s) {
+  return clip.gait ? clip.time_at_phase(phase)
+                   : std::fmod(idle_time_s, std::max(clip.clip.duration_s(), 1e-3f));
+}
+
+// The gait cycles per second of a slot's layers at native rate (weighted over its gait clips),
+// and the weight of those clips (0: no gait clip, and no frequency).
+struct GaitFrequency {
+  float cycles_per_s = 0.0f;
+  float gait_weight = 0.0f;
+};
+GaitFrequency gait_frequency(const LocomotionLibrary& library, const int16_t* layer_clip,
+                             const float* layer_weight);
+
 // Ground heading of a direction (x, z) [rad]: 0 along +z.
 inline float heading2(const glm::vec2& v) { return std::atan2(v.x, v.y); }
 
