@@ -1,5 +1,6 @@
 // The foot-lock state machine alone (mediator/foot_lock), fed hand-built clip toes at 60 Hz:
-// pinning, the heel-off rule, release without a snap, re-planting steps, resets, and no NaN.
+// pinning, the heel-off rule, release without a snap (and no faster than the clips swing),
+// re-planting steps (set down where they were carried), resets, and no NaN.
 
 #include <algorithm>
 #include <cmath>
@@ -359,6 +360,68 @@ TEST(FootLock, GoalIsNeverNaN) {
       goal = next.goal;
       ASSERT_TRUE(std::isfinite(goal.x) && std::isfinite(goal.y) && std::isfinite(goal.z))
           << "run " << run << " frame " << f;
+    }
+  }
+}
+
+// A body turning on the spot carries the clip's toe sideways at 1.5 m/s through a whole
+// re-planting step: the foot follows it while carried, and comes down on one spot.
+TEST(FootLock, StepSetsTheFootDownWhereItWasCarried) {
+  Foot foot;
+  glm::vec3 anim(0.0f, kFloor, 0.0f);
+  foot.step(anim, true, true);
+  ASSERT_EQ(foot.lock.state, FootLockState::kLocked);
+  foot.lock = start_foot_step(foot.lock, foot.goal);
+  const float speed = 1.5f;  // [m/s] of the clip's toe
+  int lowering = 0;
+  glm::vec3 set_down(0.0f);
+  for (int k = 1; k <= 40 && foot.lock.state == FootLockState::kStepping; ++k) {
+    const glm::vec3 prev_goal = foot.goal;
+    anim.x += speed * kDt;
+    const glm::vec3 goal = foot.step(anim, false, true);
+    const float t = k * kDt;
+    if (t >= (1.0f - 0.2f) * foot.params.step_time_s + kDt) {
+      // The last fifth only sets the foot down: no horizontal motion at all.
+      if (lowering++ == 0) set_down = prev_goal;
+      EXPECT_NEAR(horizontal(goal, set_down), 0.0f, 1e-6f) << k;
+    }
+  }
+  ASSERT_EQ(foot.lock.state, FootLockState::kLocked);
+  EXPECT_GE(lowering, 3);
+  // It came down where it was carried to, behind the clip's toe, which moved on.
+  const glm::vec3 landed = foot.goal;
+  EXPECT_GT(horizontal(anim, landed), 0.05f);
+  // Pinned there on the next frame.
+  anim.x += speed * kDt;
+  EXPECT_NEAR(horizontal(foot.step(anim, false, true), landed), 0.0f, 1e-6f);
+}
+
+// Released 0.75 m from a clip toe that stands still (a foot left behind in a jam): with the
+// clips' swing speed given, the foot is carried at no more than that speed; without it, the
+// release's shortest time (twice the halflife) would carry it at several times that.
+TEST(FootLock, ReleasedFootIsCarriedNoFasterThanTheClipsSwing) {
+  for (const float swing_speed : {0.0f, 3.0f}) {
+    Foot foot;
+    foot.params.swing_speed_m_s = swing_speed;
+    const glm::vec3 pinned(0.0f, kFloor, 0.0f), anim(0.75f, kFloor, 0.0f);
+    foot.step(pinned, true, true);
+    foot.lock = release_foot_lock(foot.lock, foot.goal, glm::vec3(0.0f), anim, glm::vec3(0.0f));
+    foot.anim = anim;  // the clip's toe stands there from now on
+    float fastest = 0.0f;
+    int frames = 0;
+    for (int k = 1; k <= 120 && foot.lock.state == FootLockState::kReleasing; ++k, ++frames) {
+      const glm::vec3 prev = foot.goal;
+      // A short swing of the clips (0.1 s, as at a crawl in a jam); their toe stays put.
+      const glm::vec3 goal = foot.step(anim, false, false, std::min(1.0f, k / 6.0f));
+      fastest = std::max(fastest, horizontal(goal, prev) / kDt);
+    }
+    EXPECT_NEAR(horizontal(foot.goal, anim), 0.0f, 1e-4f);
+    if (swing_speed > 0.0f) {
+      EXPECT_LE(fastest, swing_speed * 1.02f);
+      // 0.75 m at a smoothstep peaking at 3 m/s takes 1.5 * 0.75 / 3 = 0.375 s.
+      EXPECT_GE(frames, static_cast<int>(0.375f / kDt) - 1);
+    } else {
+      EXPECT_GT(fastest, 6.0f) << "the unlimited release is fast: the test would catch a drag";
     }
   }
 }
