@@ -5,6 +5,9 @@
 #include <cmath>
 #include <random>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "mediator/mediator_passes.h"
 
 namespace gk {
@@ -186,16 +189,19 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   AnimationPlans& pl = plans_;
   const bool lod = !lod_due_.empty();
   if (lod) {
-    for (size_t i = 0; i < n; ++i) {
-      const int slot = pl.slot_of_agent[i];
-      lod_plan_[slot] = lod_due_[slot] || pl.fresh[slot];
-      if (lod_plan_[slot]) {
-        lod_dt_s_[slot] = lod_step(slot, dt_s);
-      } else {
-        advance_agent(static_cast<int>(i), slot, frame.positions[i], frame.velocities[i],
-                      frame.thetas[i], dt_s);
+    // Per agent and its own slot only: in parallel, as the passes.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        const int slot = pl.slot_of_agent[i];
+        lod_plan_[slot] = lod_due_[slot] || pl.fresh[slot];
+        if (lod_plan_[slot]) {
+          lod_dt_s_[slot] = lod_step(slot, dt_s);
+        } else {
+          advance_agent(static_cast<int>(i), slot, frame.positions[i], frame.velocities[i],
+                        frame.thetas[i], dt_s);
+        }
       }
-    }
+    });
   }
 
   // The whole-crowd passes (mediator/mediator_passes.h), each over every agent due, in order.
