@@ -27,6 +27,7 @@ constexpr Label kLabels[] = {
     {"idle_step_time_s", "Re-planting step time"},
     {"feedback", "Feedback to simulator"},
     {"turn_feedback_deg", "Max path-to-legs angle"},
+    {"max_accel_m_s2", "Max speed-up"},
     {"stride_variation", "Stride variety"},
 };
 

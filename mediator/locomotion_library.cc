@@ -508,7 +508,20 @@ std::vector<std::string> describe_doubts(const LocomotionLibrary& library) {
     for (size_t i = 0; i < c.doubts.size(); ++i) line += (i ? "; " : "") + c.doubts[i];
     lines.push_back(std::move(line) + "; played without foot locks");
   }
+  if (gait_analysis_doubtful(library)) {
+    lines.push_back("every gait clip is doubtful: apm plays this library as naive does");
+  }
   return lines;
+}
+
+bool gait_analysis_doubtful(const LocomotionLibrary& library) {
+  int gait = 0;
+  for (const LocomotionClip& c : library.clips) {
+    if (!c.gait) continue;
+    ++gait;
+    if (c.doubts.empty()) return false;
+  }
+  return gait > 0;
 }
 
 std::vector<std::string> describe_left_out(const LocomotionLibrary& library) {

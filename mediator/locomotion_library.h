@@ -113,8 +113,14 @@ struct LocomotionLibrary {
 // The clips left out, one line per file and reason: "file: why: clip, clip, ...".
 std::vector<std::string> describe_left_out(const LocomotionLibrary& library);
 
-// The gait clips whose contact analysis is doubtful, one line per clip: "clip: why; why".
+// The gait clips whose contact analysis is doubtful, one line per clip: "clip: why; why"; when
+// every gait clip is, a last line says the library is played as the naive mode plays it.
 std::vector<std::string> describe_doubts(const LocomotionLibrary& library);
+
+// True when the library has gait clips and the contact analysis of every one is doubtful: nothing
+// the mediator adds (foot locks, rate and phase matching, blends aligned on contacts) can be
+// trusted with it, so apm plays it as naive does and is never worse than naive.
+bool gait_analysis_doubtful(const LocomotionLibrary& library);
 
 // Why a gait clip's analysis is doubtful (see LocomotionClip::doubts); empty when it is sound.
 // Needs the clip's analysis and phase table.

@@ -14,6 +14,7 @@ namespace gk {
 
 Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& params, size_t capacity)
     : library_(library), params_(params), capacity_(capacity), ids_(capacity) {
+  set_params(params);
   const size_t nc = library.clips.size();
   const size_t L = capacity * kMaxBlendLayers;
   slot_id_.assign(capacity, 0xffffffffu);
@@ -52,6 +53,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   sim_theta_.assign(capacity, 0.0f);
   vel_.assign(capacity, glm::vec2(0.0f));
   vel_rate_.assign(capacity, glm::vec2(0.0f));
+  fed_speed_.assign(capacity, 0.0f);
   theta_.assign(capacity, 0.0f);
   theta_rate_.assign(capacity, 0.0f);
   root_heading_.assign(capacity, 0.0f);
@@ -68,6 +70,12 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   lod_root_at_plan_.assign(capacity, glm::vec2(0.0f));
 }
 
+void Mediator::set_params(const MediatorParams& p) {
+  params_ = p;
+  degraded_ = p.mode == MediatorMode::kApm && gait_analysis_doubtful(library_);
+  if (degraded_) params_.mode = MediatorMode::kNaive;
+}
+
 void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::vec2& v,
                          float theta) {
   slot_id_[slot] = id;
@@ -75,6 +83,7 @@ void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::v
   const float th = std::isfinite(theta) ? theta : heading2(vel);
   vel_[slot] = vel;
   vel_rate_[slot] = glm::vec2(0.0f);
+  fed_speed_[slot] = glm::length(vel);
   theta_[slot] = th;
   theta_rate_[slot] = 0.0f;
   const float speed = glm::length(vel);
@@ -214,6 +223,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                         lod ? std::span<const float>(lod_dt_s_) : std::span<const float>()};
   filter_pass(crowd, frame, pl.root_xz, {vel_, vel_rate_, theta_, theta_rate_},
               {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
+  const bool honoured = params_.feedback && policy == FeedbackPolicy::kHonoured;
   root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_);
   facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw, pl.upper_yaw,
               rel_dir_);
@@ -229,8 +239,8 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                  {pl.gait_toe_y[0], pl.gait_toe_y[1]},
                  pl.double_support});
   feedback_pass(
-      crowd, params_.feedback && policy == FeedbackPolicy::kHonoured, sim_pos_, sim_vel_,
-      sim_theta_, pl.lower_yaw, pl.standing, pl.gait_weight,
+      crowd, honoured, sim_pos_, sim_vel_, sim_theta_, fed_speed_, pl.lower_yaw, pl.standing,
+      pl.gait_weight,
       {feedback_.has_feedback, feedback_.positions, feedback_.velocities, feedback_.thetas});
   if (lod) {
     for (size_t i = 0; i < n; ++i) {
@@ -255,6 +265,7 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
   sim_vel_[agent] = v;
   sim_theta_[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];
   feedback_.has_feedback[agent] = 0;
+  fed_speed_[slot] = glm::length(v);
   feedback_.positions[agent] = p;
   feedback_.velocities[agent] = v;
   feedback_.thetas[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];

@@ -63,8 +63,11 @@ class Mediator {
   size_t num_agents() const { return num_agents_; }
   size_t capacity() const { return capacity_; }
   const LocomotionLibrary& library() const { return library_; }
+  // The parameters in effect: as given, except that apm with a library whose every gait clip is
+  // doubtful (gait_analysis_doubtful) plays it as naive does (degraded()).
   const MediatorParams& params() const { return params_; }
-  void set_params(const MediatorParams& p) { params_ = p; }
+  void set_params(const MediatorParams& p);
+  bool degraded() const { return degraded_; }
   // Agents whose input had to be sanitised (NaN or speeds above 15 m/s) since construction.
   uint64_t num_sanitised() const { return num_sanitised_; }
   // Sim-side velocity of agent i of the last frame (for the feedback metric).
@@ -101,6 +104,8 @@ class Mediator {
   // Per slot, carried from frame to frame.
   std::vector<glm::vec2> vel_, vel_rate_;  // velocity spring
   std::vector<float> theta_, theta_rate_;  // theta spring (unwrapped)
+  bool degraded_ = false;  // apm asked, naive played (a doubtful library)
+  std::vector<float> fed_speed_;           // the speed the simulator was last given [m/s]
   std::vector<float> lower_target_;        // target facing of the lower body
   std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
   std::vector<float> idle_time_;           // clock of the standing clip

@@ -377,7 +377,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
 
 void feedback_pass(const PassCrowd& c, bool honoured, std::span<const glm::vec2> positions,
                    std::span<const glm::vec2> velocities, std::span<const float> thetas,
-                   std::span<const float> lower_yaw, std::span<const uint8_t> standing,
+                   std::span<float> fed_speed, std::span<const float> lower_yaw, std::span<const uint8_t> standing,
                    std::span<const float> gait_weight, FeedbackOut out) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
@@ -391,13 +391,23 @@ void feedback_pass(const PassCrowd& c, bool honoured, std::span<const glm::vec2>
     out.positions[a] = positions[a];
     out.velocities[a] = v;
     out.thetas[a] = theta_raw;
+    const float fed_before = fed_speed[slot];
+    fed_speed[slot] = glm::length(v);
     if (!(apm && honoured)) return;
     const DirectionGroup& fg = lib.groups[lib.forward_group];
     const float max_speed =
         lib.clips[fg.clips.back()].speed_m_s * P.max_playback_rate * (1.0f + P.max_stride_warp);
-    const float v_len = glm::length(v);
+    // Legs speed up over steps, not in a frame: a start from rest, or a jam clearing, is held to
+    // the speed-up they deliver (above the speed the body has now).
+    float v_len = glm::length(v);
+    const float reachable = c.fresh[slot] ? v_len : fed_before + P.max_accel_m_s2 * c.dt(slot);
+    if (v_len > reachable) {
+      out.velocities[a] = v * (reachable / v_len);
+      v_len = reachable;
+      out.has_feedback[a] = 1;
+    }
     if (v_len > max_speed) {
-      out.velocities[a] = v * (max_speed / v_len);
+      out.velocities[a] *= max_speed / v_len;
       out.has_feedback[a] = 1;
     }
     // With forward clips only, the legs walk where the lower body faces, and it turns at a
@@ -422,6 +432,7 @@ void feedback_pass(const PassCrowd& c, bool honoured, std::span<const glm::vec2>
       out.thetas[a] = wrap_pi(psi + std::clamp(twist, -limit, limit));
       out.has_feedback[a] = 1;
     }
+    fed_speed[slot] = glm::length(out.velocities[a]);
   });
 }
 

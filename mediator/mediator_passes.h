@@ -191,13 +191,15 @@ struct FeedbackOut {
   std::span<float> thetas;
 };
 // Reads the sanitised input (per agent), the lower-body yaw, `standing` and the share of gait
-// clips. Writes the feedback (per agent): the sanitised input, unflagged, unless `honoured` (APM
-// with feedback on and a source that takes it) and the animation cannot deliver it: a speed above
-// the fastest clip's reach, with forward clips only a velocity turning away from psi faster than
-// the legs, or a theta beyond the torsion limit.
+// clips; fed_speed (per slot) is the speed the simulator was given last frame, and is updated.
+// Writes the feedback (per agent): the sanitised input, unflagged, unless `honoured` (APM with
+// feedback on and a source that takes it) and the animation cannot deliver it: a speed-up faster
+// than max_accel_m_s2 over fed_speed, a speed above the fastest clip's reach, with forward
+// clips only a velocity turning away from psi faster than the legs, or a theta beyond the torsion
+// limit.
 void feedback_pass(const PassCrowd& crowd, bool honoured, std::span<const glm::vec2> positions,
                    std::span<const glm::vec2> velocities, std::span<const float> thetas,
-                   std::span<const float> lower_yaw, std::span<const uint8_t> standing,
+                   std::span<float> fed_speed, std::span<const float> lower_yaw, std::span<const uint8_t> standing,
                    std::span<const float> gait_weight, FeedbackOut out);
 
 }  // namespace gk

@@ -54,6 +54,9 @@ constexpr ParamInfo kInfos[] = {
      "forward clips only: feedback turns the simulator's velocity to within this of where the "
      "legs face (180 = off)",
      0.0f, 180.0f, K::kFloat, &P::turn_feedback_deg},
+    {"max_accel_m_s2", "m/s2",
+     "feedback holds the simulator's speed-up to what legs deliver (a start takes about a second)",
+     0.1f, 20.0f, K::kFloat, &P::max_accel_m_s2},
     {"stride_variation", "x", "per-agent spread of stride length (crowd variety)", 0.0f, 0.2f,
      K::kFloat, &P::stride_variation},
 };

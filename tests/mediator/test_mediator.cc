@@ -148,6 +148,9 @@ TEST(Mediator, FeedsBackAWalkingDirectionTheLegsCanTake) {
   const LocomotionLibrary lib = test::builtin_library_without({"strafe", "backward"});
   ASSERT_FALSE(lib.has_direction_clips());
   MediatorParams p;
+  // The turn alone: this simulator regains speed after the turn faster than legs speed up
+  // (FeedsBackAStartTheLegsCanMake), which would be fed back too.
+  p.max_accel_m_s2 = 20.0f;
   const TurningRun r = run_turn(lib, p, 135.0f, 0.0f);
   EXPECT_GE(r.feedback_frames, 5);
   EXPECT_LE(r.max_off_deg, p.turn_feedback_deg + 0.1f);
@@ -168,6 +171,50 @@ TEST(Mediator, TurnFeedbackLeavesLibrariesWithDirectionClipsAlone) {
   const TurningRun r = run_turn(lib, MediatorParams{}, 0.0f, 100.0f);
   EXPECT_EQ(r.feedback_frames, 0);
   EXPECT_NEAR(r.position.x, 0.0f, 0.01f);
+}
+
+// A simulator that asks a standing agent for walking speed at once (social forces and Detour both
+// can: their acceleration is a force, not a gait) is held to the speed-up legs deliver: the agent
+// starts over about a second (1.5 m/s at max_accel_m_s2 = 1.5), never in a frame, and gets there.
+// Returns the frames from the request until the fed-back speed reached 99% of it.
+int frames_to_start(const MediatorParams& p, float want_m_s) {
+  const LocomotionLibrary& lib = builtin_library();
+  Mediator m(lib, p, 1);
+  const uint32_t id = 1;
+  glm::vec2 pos(0.0f), vel(0.0f);
+  const float theta = 0.0f;
+  constexpr float kDt = 1.0f / 60.0f;
+  float last = 0.0f;
+  for (int f = 0; f < 300; ++f) {
+    if (f >= 30) vel = glm::vec2(0.0f, want_m_s);  // the simulator's wish, every frame
+    EXPECT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt,
+                       FeedbackPolicy::kHonoured)
+                    .ok());
+    // The source honours it: the velocity it moves with is the one fed back.
+    const glm::vec2 fed = m.feedback().velocities[0];
+    const float speed = glm::length(fed);
+    // Never more than one frame of the limit above what the body had (which lags behind it).
+    EXPECT_LE(speed, last + p.max_accel_m_s2 * kDt + 1e-4f) << f;
+    last = std::max(last, speed);
+    if (f >= 30 && speed >= 0.99f * want_m_s) return f - 30;
+    vel = fed;
+    pos += vel * kDt;
+  }
+  return -1;
+}
+
+TEST(Mediator, FeedsBackAStartTheLegsCanMake) {
+  MediatorParams p;
+  const int frames = frames_to_start(p, 1.5f);
+  ASSERT_GE(frames, 0) << "the agent never got to its speed";
+  // 99% of 1.5 m/s at 1.5 m/s^2: 0.99 s at the very least (59 frames).
+  EXPECT_GE(frames, static_cast<int>(0.99f * 1.5f / p.max_accel_m_s2 * 60.0f));
+  EXPECT_LE(frames, 120);
+  // A limit as high as the simulator's own: the start is the simulator's, within a few frames.
+  p.max_accel_m_s2 = 20.0f;
+  const int fast = frames_to_start(p, 1.5f);
+  ASSERT_GE(fast, 0);
+  EXPECT_LT(fast, 30);
 }
 
 TEST(Mediator, AsksNoFeedbackOfASourceThatIgnoresIt) {
