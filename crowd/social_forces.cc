@@ -164,9 +164,8 @@ Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scena
     s.heading_[i] = s.theta_[i] = glm::dot(to_goal, to_goal) > 0.0f ? angle_of(to_goal) : 0.0f;
   }
   s.new_velocity_.resize(n);
-  s.sorted_position_.resize(n);
-  s.sorted_velocity_.resize(n);
-  s.sorted_radius_.resize(n);
+  s.body_.resize(n);
+  s.sorted_.resize(n);
   return sim;
 }
 
@@ -187,13 +186,13 @@ Status SocialForces::step(float dt_s) {
     return Status::Error("social forces: step dt_s " + std::to_string(dt_s) +
                          ": expected a value in (0, 0.5]");
   }
+  for_agents([&](size_t b, size_t e) { prepare(b, e); });
   impl_->grid.build({position_.data(), num_});
   const auto order = impl_->grid.order();
-  for (size_t k = 0; k < num_; ++k) {  // gather in cell order: neighbours become contiguous
-    sorted_position_[k] = position_[order[k]];
-    sorted_velocity_[k] = velocity_[order[k]];
-    sorted_radius_[k] = radius_[order[k]];
-  }
+  // Gather in cell order, so that neighbours are contiguous: one record read per agent.
+  for_agents([&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) sorted_[k] = body_[order[k]];
+  });
   impl_->non_finite.store(false, std::memory_order_relaxed);
   for_agents([&](size_t b, size_t e) { compute_velocities(b, e, dt_s); });
   for_agents([&](size_t b, size_t e) { commit(b, e, dt_s); });
@@ -203,6 +202,21 @@ Status SocialForces::step(float dt_s) {
     return Status::Error("social forces: non-finite velocity computed (agents held in place)");
   }
   return Status::Ok();
+}
+
+// Pass 0: the records of agents [begin, end) in index order, read sequentially (the waypoint
+// chains too, which a cell-order walk would visit at random).
+void SocialForces::prepare(size_t begin, size_t end) {
+  for (size_t i = begin; i < end; ++i) {
+    const glm::vec2 pos = position_[i];
+    glm::vec2 dir(0.0f);  // desired direction e
+    if (!arrived_[i]) {
+      const glm::vec2 to_goal = waypoints_[waypoint_[i]] - pos;
+      const float len = glm::length(to_goal);
+      if (len > 1e-6f) dir = to_goal / len;
+    }
+    body_[i] = Body{pos, velocity_[i], dir, radius_[i], desired_speed_[i]};
+  }
 }
 
 // Pass 1: new velocity of the agents at sorted positions [begin, end), from the frozen state.
@@ -219,16 +233,15 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
   const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
   for (size_t k = begin; k < end; ++k) {
     const uint32_t i = order[k];
-    const glm::vec2 pos = sorted_position_[k];
-    const glm::vec2 vel = sorted_velocity_[k];
-    const float r_i = sorted_radius_[k];
-    glm::vec2 dir(0.0f);  // desired direction e
-    if (!arrived_[i]) {
-      const glm::vec2 to_goal = waypoints_[waypoint_[i]] - pos;
-      const float len = glm::length(to_goal);
-      if (len > 1e-6f) dir = to_goal / len;
-    }
-    glm::vec2 acc = (desired_speed_[i] * dir - vel) * inv_tau;
+    const Body& self = sorted_[k];
+    const glm::vec2 pos = self.position;
+    const glm::vec2 vel = self.velocity;
+    const float r_i = self.radius;
+    const glm::vec2 dir = self.direction;
+    // max_speed_ is max_speed_factor x desired_speed_ (create()), computed again here bit for bit
+    // rather than gathered.
+    const float max_speed = p.max_speed_factor * self.desired_speed;
+    glm::vec2 acc = (self.desired_speed * dir - vel) * inv_tau;
     // Facing for the field of view: the velocity, or the desired direction when (nearly) still.
     const float speed = glm::length(vel);
     const glm::vec2 facing = speed > 0.1f ? vel / speed : dir;
@@ -237,7 +250,8 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     for (int z = cz - 1; z <= cz + 1; ++z) {
       const auto [m0, m1] = grid.row_range(z, cx - 1, cx + 1);
       for (uint32_t m = m0; m < m1; ++m) {
-        const glm::vec2 d = pos - sorted_position_[m];
+        const Body& other = sorted_[m];
+        const glm::vec2 d = pos - other.position;
         const float d2 = glm::dot(d, d);
         if (d2 >= cutoff2 || m == k) continue;
         glm::vec2 n;
@@ -249,14 +263,14 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
           dist = 0.0f;
           n = glm::vec2(id_[i] < id_[order[m]] ? -1.0f : 1.0f, 0.0f);
         }
-        const float overlap = r_i + sorted_radius_[m] - dist;
+        const float overlap = r_i + other.radius - dist;
         const float cos_phi = -glm::dot(n, facing);  // 1: the other is straight ahead
         const float w = lambda + (1.0f - lambda) * 0.5f * (1.0f + cos_phi);
         // Elliptical specification II (Johansson, Helbing & Shukla 2007): the distance is replaced
         // by the semi-minor axis b of an ellipse through p_i with foci at p_j and at p_j moved by
         // the relative velocity over the anticipation time, so agents on a collision course repel
         // early and sideways, while agents walking alongside barely interact.
-        const glm::vec2 y = (sorted_velocity_[m] - vel) * p.anticipation_time_s;
+        const glm::vec2 y = (other.velocity - vel) * p.anticipation_time_s;
         const glm::vec2 dy = d - y;
         const float dy_len = std::sqrt(glm::dot(dy, dy));
         const float sum = dist + dy_len;
@@ -266,7 +280,7 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
         const float stretch = sum / (2.0f * std::max(b, 0.1f * sum + 1e-6f));
         const glm::vec2 dir = 0.5f * (n + (dy_len > 1e-6f ? dy / dy_len : n));
         const float repulsion =
-            p.agent_strength_m_s2 * std::exp((r_i + sorted_radius_[m] - b) * inv_b) * w * stretch;
+            p.agent_strength_m_s2 * std::exp((r_i + other.radius - b) * inv_b) * w * stretch;
         acc += repulsion * dir;
         if (cos_phi > 0.0f) acc += (p.side_step * repulsion * cos_phi) * right;
         if (overlap > 0.0f) acc += (stiffness * overlap) * n;
@@ -285,7 +299,7 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     }
     glm::vec2 v_new = vel + acc * dt_s;
     const float s2 = glm::dot(v_new, v_new);
-    if (s2 > max_speed_[i] * max_speed_[i]) v_new *= max_speed_[i] / std::sqrt(s2);
+    if (s2 > max_speed * max_speed) v_new *= max_speed / std::sqrt(s2);
     if (!finite(v_new)) {
       impl_->non_finite.store(true, std::memory_order_relaxed);
       v_new = glm::vec2(0.0f);

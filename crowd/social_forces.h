@@ -90,6 +90,7 @@ class SocialForces final : public CrowdSource {
  private:
   struct Impl;
   SocialForces(const SocialForceParams& params, size_t capacity);
+  void prepare(size_t begin, size_t end);
   void compute_velocities(size_t begin, size_t end, float dt_s);
   void commit(size_t begin, size_t end, float dt_s);
   void remove_finished();
@@ -113,10 +114,16 @@ class SocialForces final : public CrowdSource {
   std::vector<uint8_t> loop_, remove_at_goal_, attentive_, arrived_, reached_;
   std::vector<glm::vec2> waypoints_;  // all chains, immutable
   std::vector<AttentionTarget> targets_;
-  // Scratch of one step.
+  // Scratch of one step. What the velocity pass reads of an agent, packed into one 32-byte record
+  // so that gathering it into cell order costs one cache line per agent: body_ in index order
+  // (written by a sequential pass), sorted_ in the grid's cell order.
+  struct Body {
+    glm::vec2 position, velocity;
+    glm::vec2 direction;  // desired direction e toward the current waypoint; 0 when arrived
+    float radius, desired_speed;
+  };
+  std::vector<Body> body_, sorted_;
   std::vector<glm::vec2> new_velocity_;
-  std::vector<glm::vec2> sorted_position_, sorted_velocity_;
-  std::vector<float> sorted_radius_;
 };
 
 }  // namespace gk
