@@ -145,6 +145,7 @@ Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scena
   s.waypoint_.resize(n);
   s.waypoint_begin_.resize(n);
   s.waypoint_end_.resize(n);
+  s.goal_.resize(n);
   s.loop_ = agents.loop_waypoints;
   s.remove_at_goal_.assign(n, 0);
   s.attentive_.assign(n, 1);
@@ -159,6 +160,7 @@ Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scena
     s.waypoint_begin_[i] = s.waypoint_[i] = agents.waypoint_begin[i];
     s.waypoint_end_[i] = agents.waypoint_begin[i + 1];
     s.arrived_[i] = s.waypoint_begin_[i] == s.waypoint_end_[i] ? 1 : 0;  // nowhere to go: stand
+    s.goal_[i] = s.arrived_[i] ? s.position_[i] : s.waypoints_[s.waypoint_[i]];
     const glm::vec2 to_goal =
         s.arrived_[i] ? glm::vec2(0.0f, 1.0f) : s.waypoints_[s.waypoint_[i]] - s.position_[i];
     s.heading_[i] = s.theta_[i] = glm::dot(to_goal, to_goal) > 0.0f ? angle_of(to_goal) : 0.0f;
@@ -204,14 +206,13 @@ Status SocialForces::step(float dt_s) {
   return Status::Ok();
 }
 
-// Pass 0: the records of agents [begin, end) in index order, read sequentially (the waypoint
-// chains too, which a cell-order walk would visit at random).
+// Pass 0: the records of agents [begin, end), from their arrays read sequentially.
 void SocialForces::prepare(size_t begin, size_t end) {
   for (size_t i = begin; i < end; ++i) {
     const glm::vec2 pos = position_[i];
     glm::vec2 dir(0.0f);  // desired direction e
     if (!arrived_[i]) {
-      const glm::vec2 to_goal = waypoints_[waypoint_[i]] - pos;
+      const glm::vec2 to_goal = goal_[i] - pos;
       const float len = glm::length(to_goal);
       if (len > 1e-6f) dir = to_goal / len;
     }
@@ -322,7 +323,7 @@ void SocialForces::commit(size_t begin, size_t end, float dt_s) {
     if (s2 > max_speed_[i] * max_speed_[i]) vel *= max_speed_[i] / std::sqrt(s2);
     position_[i] = to;
     velocity_[i] = vel;
-    if (!arrived_[i] && glm::length(waypoints_[waypoint_[i]] - to) < goal_radius_[i]) {
+    if (!arrived_[i] && glm::length(goal_[i] - to) < goal_radius_[i]) {
       if (waypoint_[i] + 1 < waypoint_end_[i]) {
         ++waypoint_[i];
       } else {
@@ -333,6 +334,7 @@ void SocialForces::commit(size_t begin, size_t end, float dt_s) {
           arrived_[i] = 1;
         }
       }
+      goal_[i] = waypoints_[waypoint_[i]];
     }
     // Heading: exponential smoothing of the walking direction, slowed down in proportion to the
     // speed below heading_speed_m_s so that jitter of a standing agent does not spin it.
@@ -380,6 +382,7 @@ void SocialForces::remove_finished() {
       waypoint_[out] = waypoint_[i];
       waypoint_begin_[out] = waypoint_begin_[i];
       waypoint_end_[out] = waypoint_end_[i];
+      goal_[out] = goal_[i];
       loop_[out] = loop_[i];
       remove_at_goal_[out] = remove_at_goal_[i];
       attentive_[out] = attentive_[i];

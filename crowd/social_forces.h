@@ -111,6 +111,7 @@ class SocialForces final : public CrowdSource {
   std::vector<float> theta_, heading_;
   std::vector<float> desired_speed_, max_speed_, radius_, goal_radius_;
   std::vector<uint32_t> waypoint_, waypoint_begin_, waypoint_end_;  // current, chain [begin, end)
+  std::vector<glm::vec2> goal_;  // waypoints_[waypoint_[i]], kept beside it for sequential reads
   std::vector<uint8_t> loop_, remove_at_goal_, attentive_, arrived_, reached_;
   std::vector<glm::vec2> waypoints_;  // all chains, immutable
   std::vector<AttentionTarget> targets_;
