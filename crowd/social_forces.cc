@@ -23,8 +23,10 @@ constexpr float kGridMargin = 5.0f;  // agent grid extends this far past everyth
 constexpr size_t kGrain = 512;       // agents per parallel task: amortises scheduling
 
 float wrap_angle(float a) {
-  a = std::remainder(a, 2.0f * kPi);
-  return a;
+  // remainder() returns a itself within [-pi, pi] (2 kPi / 2 == kPi exactly): skip the call, most
+  // angles are there already.
+  if (std::abs(a) <= kPi) return a;
+  return std::remainder(a, 2.0f * kPi);
 }
 // theta convention of crowd_source.h: 0 faces +z, pi/2 faces +x.
 float angle_of(glm::vec2 d) { return std::atan2(d.x, d.y); }
