@@ -90,6 +90,14 @@ class SocialForces final : public CrowdSource {
  private:
   struct Impl;
   SocialForces(const SocialForceParams& params, size_t capacity);
+  // What one agent's neighbour forces need of it.
+  struct AgentTerms {
+    glm::vec2 position, velocity, facing, right;
+    float radius;
+  };
+  void add_neighbour_force(const AgentTerms& a, size_t k, uint32_t m, glm::vec2* acc) const;
+  void add_neighbour_forces(const AgentTerms& a, size_t k, const uint32_t* candidates,
+                            uint32_t count, glm::vec2* acc) const;
   void prepare(size_t begin, size_t end);
   void compute_velocities(size_t begin, size_t end, float dt_s);
   void commit(size_t begin, size_t end, float dt_s);
