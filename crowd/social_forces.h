@@ -10,9 +10,12 @@
 // a wall (the step is slid along the wall or cancelled) and agents are kept their radius away.
 //
 // One step is two whole-crowd passes over flat arrays: compute every new velocity from the frozen
-// state, then commit positions, waypoints and orientations. Each agent sums its neighbours in a
-// fixed order (uniform-grid cell order), so results do not depend on the thread count: runs with
-// threads = 2 equal threads = 1 bit for bit. Capacity and scratch are fixed at creation.
+// state, then commit positions, waypoints and orientations. The velocity pass walks the agents in
+// uniform-grid cell order over a packed copy of what it reads, so neighbours are contiguous in
+// memory, and computes the neighbour forces four at a time (SSE2, the same operations as one at a
+// time). Each agent sums its neighbours in a fixed order (cell order), so results do not depend on
+// the thread count: runs with threads = 2 equal threads = 1 bit for bit. Capacity and scratch are
+// fixed at creation.
 
 #include <cstdint>
 #include <memory>
