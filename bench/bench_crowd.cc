@@ -1,6 +1,6 @@
-// Social forces step cost at 1,000 and 10,000 agents in the plaza scenario (an open square with
-// random goals, its geometry scaled so the density stays moderate: ~0.4 agents/m^2), single
-// threaded. Target: < 1.5 us per agent per step at 10,000 agents.
+// Social forces step cost at 1,000, 10,000 and 100,000 agents in the plaza scenario (an open
+// square with random goals, its geometry scaled so the density stays moderate: ~0.4 agents/m^2),
+// on 1 and 2 threads. Target: < 1.5 us per agent per step at 10,000 agents.
 #include <cstdio>
 
 #include <benchmark/benchmark.h>
@@ -35,6 +35,8 @@ BENCHMARK(BM_SocialForcesStep)
     ->Args({1000, 1})
     ->Args({10000, 1})
     ->Args({10000, 2})
+    ->Args({100000, 1})
+    ->Args({100000, 2})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <cmath>
 #include <numbers>
 #include <string>
 
+#include <emmintrin.h>
+#include <xmmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -21,10 +24,13 @@ constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kWallReach = 1.5f;   // walls listed per cell: covers a step plus a body [m]
 constexpr float kGridMargin = 5.0f;  // agent grid extends this far past everything known [m]
 constexpr size_t kGrain = 512;       // agents per parallel task: amortises scheduling
+constexpr uint32_t kCandidates = 64;  // neighbours buffered before their forces are summed
 
 float wrap_angle(float a) {
-  a = std::remainder(a, 2.0f * kPi);
-  return a;
+  // remainder() returns a itself within [-pi, pi] (2 kPi / 2 == kPi exactly): skip the call, most
+  // angles are there already.
+  if (std::abs(a) <= kPi) return a;
+  return std::remainder(a, 2.0f * kPi);
 }
 // theta convention of crowd_source.h: 0 faces +z, pi/2 faces +x.
 float angle_of(glm::vec2 d) { return std::atan2(d.x, d.y); }
@@ -145,6 +151,7 @@ Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scena
   s.waypoint_.resize(n);
   s.waypoint_begin_.resize(n);
   s.waypoint_end_.resize(n);
+  s.goal_.resize(n);
   s.loop_ = agents.loop_waypoints;
   s.remove_at_goal_.assign(n, 0);
   s.attentive_.assign(n, 1);
@@ -159,14 +166,14 @@ Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scena
     s.waypoint_begin_[i] = s.waypoint_[i] = agents.waypoint_begin[i];
     s.waypoint_end_[i] = agents.waypoint_begin[i + 1];
     s.arrived_[i] = s.waypoint_begin_[i] == s.waypoint_end_[i] ? 1 : 0;  // nowhere to go: stand
+    s.goal_[i] = s.arrived_[i] ? s.position_[i] : s.waypoints_[s.waypoint_[i]];
     const glm::vec2 to_goal =
         s.arrived_[i] ? glm::vec2(0.0f, 1.0f) : s.waypoints_[s.waypoint_[i]] - s.position_[i];
     s.heading_[i] = s.theta_[i] = glm::dot(to_goal, to_goal) > 0.0f ? angle_of(to_goal) : 0.0f;
   }
   s.new_velocity_.resize(n);
-  s.sorted_position_.resize(n);
-  s.sorted_velocity_.resize(n);
-  s.sorted_radius_.resize(n);
+  s.body_.resize(n);
+  s.sorted_.resize(n);
   return sim;
 }
 
@@ -187,13 +194,13 @@ Status SocialForces::step(float dt_s) {
     return Status::Error("social forces: step dt_s " + std::to_string(dt_s) +
                          ": expected a value in (0, 0.5]");
   }
+  for_agents([&](size_t b, size_t e) { prepare(b, e); });
   impl_->grid.build({position_.data(), num_});
   const auto order = impl_->grid.order();
-  for (size_t k = 0; k < num_; ++k) {  // gather in cell order: neighbours become contiguous
-    sorted_position_[k] = position_[order[k]];
-    sorted_velocity_[k] = velocity_[order[k]];
-    sorted_radius_[k] = radius_[order[k]];
-  }
+  // Gather in cell order, so that neighbours are contiguous: one record read per agent.
+  for_agents([&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) sorted_[k] = body_[order[k]];
+  });
   impl_->non_finite.store(false, std::memory_order_relaxed);
   for_agents([&](size_t b, size_t e) { compute_velocities(b, e, dt_s); });
   for_agents([&](size_t b, size_t e) { commit(b, e, dt_s); });
@@ -205,73 +212,205 @@ Status SocialForces::step(float dt_s) {
   return Status::Ok();
 }
 
+// Pass 0: the records of agents [begin, end), from their arrays read sequentially.
+void SocialForces::prepare(size_t begin, size_t end) {
+  for (size_t i = begin; i < end; ++i) {
+    const glm::vec2 pos = position_[i];
+    glm::vec2 dir(0.0f);  // desired direction e
+    if (!arrived_[i]) {
+      const glm::vec2 to_goal = goal_[i] - pos;
+      const float len = glm::length(to_goal);
+      if (len > 1e-6f) dir = to_goal / len;
+    }
+    body_[i] = Body{pos, velocity_[i], dir, radius_[i], desired_speed_[i]};
+  }
+}
+
+// The force of one neighbour (sorted index m) on an agent, added to *acc. The four-wide path
+// below computes the same IEEE operations in the same order, so either gives the same bits.
+void SocialForces::add_neighbour_force(const AgentTerms& a, size_t k, uint32_t m,
+                                       glm::vec2* acc) const {
+  const SocialForceParams& p = params_;
+  const Body& other = sorted_[m];
+  const glm::vec2 d = a.position - other.position;
+  const float d2 = glm::dot(d, d);
+  glm::vec2 n;
+  float dist;
+  if (d2 > 1e-12f) {
+    dist = std::sqrt(d2);
+    n = d / dist;
+  } else {  // same spot: separate by id so the pair pushes apart symmetrically
+    const auto order = impl_->grid.order();
+    dist = 0.0f;
+    n = glm::vec2(id_[order[k]] < id_[order[m]] ? -1.0f : 1.0f, 0.0f);
+  }
+  const float overlap = a.radius + other.radius - dist;
+  const float cos_phi = -glm::dot(n, a.facing);  // 1: the other is straight ahead
+  const float lambda = p.field_of_view_weight;
+  const float w = lambda + (1.0f - lambda) * 0.5f * (1.0f + cos_phi);
+  // Elliptical specification II (Johansson, Helbing & Shukla 2007): the distance is replaced by
+  // the semi-minor axis b of an ellipse through p_i with foci at p_j and at p_j moved by the
+  // relative velocity over the anticipation time, so agents on a collision course repel early and
+  // sideways, while agents walking alongside barely interact.
+  const glm::vec2 y = (other.velocity - a.velocity) * p.anticipation_time_s;
+  const glm::vec2 dy = d - y;
+  const float dy_len = std::sqrt(glm::dot(dy, dy));
+  const float sum = dist + dy_len;
+  const float b = 0.5f * std::sqrt(std::max(sum * sum - glm::dot(y, y), 0.0f));
+  // The potential's gradient grows as sum / 2b; capping b keeps it finite when the other is
+  // predicted to pass right through p_i.
+  const float stretch = sum / (2.0f * std::max(b, 0.1f * sum + 1e-6f));
+  const glm::vec2 dir = 0.5f * (n + (dy_len > 1e-6f ? dy / dy_len : n));
+  const float repulsion = p.agent_strength_m_s2 *
+                          std::exp((a.radius + other.radius - b) * (1.0f / p.agent_range_m)) * w *
+                          stretch;
+  *acc += repulsion * dir;
+  if (cos_phi > 0.0f) *acc += (p.side_step * repulsion * cos_phi) * a.right;
+  const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
+  if (overlap > 0.0f) *acc += (stiffness * overlap) * n;
+}
+
+namespace {
+// std::max(a, b) lane by lane, ties and signed zeros included: (a < b) ? b : a.
+__m128 max_as_std(__m128 a, __m128 b) {
+  const __m128 less = _mm_cmplt_ps(a, b);
+  return _mm_or_ps(_mm_and_ps(less, b), _mm_andnot_ps(less, a));
+}
+__m128 select(__m128 mask, __m128 if_true, __m128 if_false) {
+  return _mm_or_ps(_mm_and_ps(mask, if_true), _mm_andnot_ps(mask, if_false));
+}
+}  // namespace
+
+// add_neighbour_force for candidates[0, count) in order, four at a time with SSE2 (the exp()
+// stays the library's, per lane). A group with a neighbour on the very same spot goes the scalar
+// way, which separates the pair by id.
+void SocialForces::add_neighbour_forces(const AgentTerms& a, size_t k, const uint32_t* candidates,
+                                        uint32_t count, glm::vec2* acc) const {
+  const SocialForceParams& p = params_;
+  const __m128 px = _mm_set1_ps(a.position.x), pz = _mm_set1_ps(a.position.y);
+  const __m128 vx = _mm_set1_ps(a.velocity.x), vz = _mm_set1_ps(a.velocity.y);
+  const __m128 fx = _mm_set1_ps(a.facing.x), fz = _mm_set1_ps(a.facing.y);
+  const __m128 ri = _mm_set1_ps(a.radius);
+  const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f);
+  const __m128 lambda = _mm_set1_ps(p.field_of_view_weight);
+  const __m128 lambda_rest = _mm_set1_ps(1.0f - p.field_of_view_weight);
+  const __m128 anticipation = _mm_set1_ps(p.anticipation_time_s);
+  const __m128 inv_b = _mm_set1_ps(1.0f / p.agent_range_m);
+  const float strength = p.agent_strength_m_s2;
+  const float side_step = p.side_step;
+  const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
+  for (uint32_t g = 0; g < count; g += 4) {
+    const uint32_t lanes = std::min(count - g, 4u);
+    // Unused lanes repeat the group's first neighbour. Each record starts with position and
+    // velocity: four loads and a transpose give them lane by lane.
+    const Body& o0 = sorted_[candidates[g]];
+    const Body& o1 = sorted_[candidates[g + (lanes > 1 ? 1 : 0)]];
+    const Body& o2 = sorted_[candidates[g + (lanes > 2 ? 2 : 0)]];
+    const Body& o3 = sorted_[candidates[g + (lanes > 3 ? 3 : 0)]];
+    static_assert(offsetof(Body, velocity) == 2 * sizeof(float));
+    __m128 ox = _mm_loadu_ps(&o0.position.x), oz = _mm_loadu_ps(&o1.position.x);
+    __m128 ovx = _mm_loadu_ps(&o2.position.x), ovz = _mm_loadu_ps(&o3.position.x);
+    _MM_TRANSPOSE4_PS(ox, oz, ovx, ovz);
+    const __m128 orad = _mm_setr_ps(o0.radius, o1.radius, o2.radius, o3.radius);
+    const __m128 dx = _mm_sub_ps(px, ox), dz = _mm_sub_ps(pz, oz);
+    const __m128 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dz, dz));
+    if (_mm_movemask_ps(_mm_cmple_ps(d2, _mm_set1_ps(1e-12f))) & ((1 << lanes) - 1)) {
+      for (uint32_t l = 0; l < lanes; ++l) add_neighbour_force(a, k, candidates[g + l], acc);
+      continue;
+    }
+    const __m128 dist = _mm_sqrt_ps(d2);
+    const __m128 nx = _mm_div_ps(dx, dist), nz = _mm_div_ps(dz, dist);
+    const __m128 radii = _mm_add_ps(ri, orad);
+    const __m128 overlap = _mm_sub_ps(radii, dist);
+    const __m128 cos_phi =  // negated by the sign bit, as unary minus does
+        _mm_xor_ps(_mm_set1_ps(-0.0f), _mm_add_ps(_mm_mul_ps(nx, fx), _mm_mul_ps(nz, fz)));
+    const __m128 w = _mm_add_ps(lambda, _mm_mul_ps(_mm_mul_ps(lambda_rest, half),
+                                                   _mm_add_ps(one, cos_phi)));
+    const __m128 yx = _mm_mul_ps(_mm_sub_ps(ovx, vx), anticipation);
+    const __m128 yz = _mm_mul_ps(_mm_sub_ps(ovz, vz), anticipation);
+    const __m128 dyx = _mm_sub_ps(dx, yx), dyz = _mm_sub_ps(dz, yz);
+    const __m128 dy_len = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dyx, dyx), _mm_mul_ps(dyz, dyz)));
+    const __m128 sum = _mm_add_ps(dist, dy_len);
+    const __m128 yy = _mm_add_ps(_mm_mul_ps(yx, yx), _mm_mul_ps(yz, yz));
+    const __m128 b = _mm_mul_ps(
+        half, _mm_sqrt_ps(max_as_std(_mm_sub_ps(_mm_mul_ps(sum, sum), yy), zero)));
+    const __m128 floor_b =
+        _mm_add_ps(_mm_mul_ps(_mm_set1_ps(0.1f), sum), _mm_set1_ps(1e-6f));
+    const __m128 stretch =
+        _mm_div_ps(sum, _mm_mul_ps(_mm_set1_ps(2.0f), max_as_std(b, floor_b)));
+    const __m128 has_dy = _mm_cmpgt_ps(dy_len, _mm_set1_ps(1e-6f));
+    const __m128 ux = select(has_dy, _mm_div_ps(dyx, dy_len), nx);
+    const __m128 uz = select(has_dy, _mm_div_ps(dyz, dy_len), nz);
+    const __m128 dirx = _mm_mul_ps(half, _mm_add_ps(nx, ux));
+    const __m128 dirz = _mm_mul_ps(half, _mm_add_ps(nz, uz));
+    alignas(16) float arg[4], e[4];
+    _mm_store_ps(arg, _mm_mul_ps(_mm_sub_ps(radii, b), inv_b));
+    for (uint32_t l = 0; l < 4; ++l) e[l] = std::exp(arg[l]);
+    const __m128 repulsion =
+        _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(strength), _mm_load_ps(e)), w), stretch);
+    alignas(16) float rx[4], rz[4], side[4], cosv[4], contact[4], ox_n[4], oz_n[4];
+    _mm_store_ps(rx, _mm_mul_ps(repulsion, dirx));
+    _mm_store_ps(rz, _mm_mul_ps(repulsion, dirz));
+    _mm_store_ps(side, _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(side_step), repulsion), cos_phi));
+    _mm_store_ps(cosv, cos_phi);
+    _mm_store_ps(contact, _mm_mul_ps(_mm_set1_ps(stiffness), overlap));
+    alignas(16) float ov[4];
+    _mm_store_ps(ov, overlap);
+    _mm_store_ps(ox_n, nx);
+    _mm_store_ps(oz_n, nz);
+    for (uint32_t l = 0; l < lanes; ++l) {
+      *acc += glm::vec2(rx[l], rz[l]);
+      if (cosv[l] > 0.0f) *acc += side[l] * a.right;
+      if (ov[l] > 0.0f) *acc += contact[l] * glm::vec2(ox_n[l], oz_n[l]);
+    }
+  }
+}
+
 // Pass 1: new velocity of the agents at sorted positions [begin, end), from the frozen state.
 void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
   const UniformGrid& grid = impl_->grid;
   const auto order = grid.order();
   const SocialForceParams& p = params_;
   const float inv_tau = 1.0f / p.relaxation_time_s;
-  const float inv_b = 1.0f / p.agent_range_m;
   const float inv_bw = 1.0f / p.wall_range_m;
   const float cutoff2 = p.neighbour_radius_m * p.neighbour_radius_m;
   const float wall_cutoff2 = p.wall_radius_m * p.wall_radius_m;
-  const float lambda = p.field_of_view_weight;
   const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
   for (size_t k = begin; k < end; ++k) {
     const uint32_t i = order[k];
-    const glm::vec2 pos = sorted_position_[k];
-    const glm::vec2 vel = sorted_velocity_[k];
-    const float r_i = sorted_radius_[k];
-    glm::vec2 dir(0.0f);  // desired direction e
-    if (!arrived_[i]) {
-      const glm::vec2 to_goal = waypoints_[waypoint_[i]] - pos;
-      const float len = glm::length(to_goal);
-      if (len > 1e-6f) dir = to_goal / len;
-    }
-    glm::vec2 acc = (desired_speed_[i] * dir - vel) * inv_tau;
+    const Body& self = sorted_[k];
+    const glm::vec2 pos = self.position;
+    const glm::vec2 vel = self.velocity;
+    const float r_i = self.radius;
+    const glm::vec2 dir = self.direction;
+    // max_speed_ is max_speed_factor x desired_speed_ (create()), computed again here bit for bit
+    // rather than gathered.
+    const float max_speed = p.max_speed_factor * self.desired_speed;
+    glm::vec2 acc = (self.desired_speed * dir - vel) * inv_tau;
     // Facing for the field of view: the velocity, or the desired direction when (nearly) still.
     const float speed = glm::length(vel);
     const glm::vec2 facing = speed > 0.1f ? vel / speed : dir;
     const glm::vec2 right(-facing.y, facing.x);
+    const AgentTerms terms{pos, vel, facing, right, r_i};
     const auto [cx, cz] = grid.cell_of(pos);
+    // The neighbours within the cutoff, in cell order, go through a small buffer (written without
+    // a branch) and their forces are computed four at a time; the sums stay in neighbour order.
+    uint32_t candidates[kCandidates];
+    uint32_t count = 0;
     for (int z = cz - 1; z <= cz + 1; ++z) {
       const auto [m0, m1] = grid.row_range(z, cx - 1, cx + 1);
       for (uint32_t m = m0; m < m1; ++m) {
-        const glm::vec2 d = pos - sorted_position_[m];
+        const glm::vec2 d = pos - sorted_[m].position;
         const float d2 = glm::dot(d, d);
-        if (d2 >= cutoff2 || m == k) continue;
-        glm::vec2 n;
-        float dist;
-        if (d2 > 1e-12f) {
-          dist = std::sqrt(d2);
-          n = d / dist;
-        } else {  // same spot: separate by id so the pair pushes apart symmetrically
-          dist = 0.0f;
-          n = glm::vec2(id_[i] < id_[order[m]] ? -1.0f : 1.0f, 0.0f);
+        candidates[count] = m;
+        count += static_cast<uint32_t>(d2 < cutoff2) & static_cast<uint32_t>(m != k);
+        if (count == kCandidates) {
+          add_neighbour_forces(terms, k, candidates, count, &acc);
+          count = 0;
         }
-        const float overlap = r_i + sorted_radius_[m] - dist;
-        const float cos_phi = -glm::dot(n, facing);  // 1: the other is straight ahead
-        const float w = lambda + (1.0f - lambda) * 0.5f * (1.0f + cos_phi);
-        // Elliptical specification II (Johansson, Helbing & Shukla 2007): the distance is replaced
-        // by the semi-minor axis b of an ellipse through p_i with foci at p_j and at p_j moved by
-        // the relative velocity over the anticipation time, so agents on a collision course repel
-        // early and sideways, while agents walking alongside barely interact.
-        const glm::vec2 y = (sorted_velocity_[m] - vel) * p.anticipation_time_s;
-        const glm::vec2 dy = d - y;
-        const float dy_len = std::sqrt(glm::dot(dy, dy));
-        const float sum = dist + dy_len;
-        const float b = 0.5f * std::sqrt(std::max(sum * sum - glm::dot(y, y), 0.0f));
-        // The potential's gradient grows as sum / 2b; capping b keeps it finite when the other is
-        // predicted to pass right through p_i.
-        const float stretch = sum / (2.0f * std::max(b, 0.1f * sum + 1e-6f));
-        const glm::vec2 dir = 0.5f * (n + (dy_len > 1e-6f ? dy / dy_len : n));
-        const float repulsion =
-            p.agent_strength_m_s2 * std::exp((r_i + sorted_radius_[m] - b) * inv_b) * w * stretch;
-        acc += repulsion * dir;
-        if (cos_phi > 0.0f) acc += (p.side_step * repulsion * cos_phi) * right;
-        if (overlap > 0.0f) acc += (stiffness * overlap) * n;
       }
     }
+    add_neighbour_forces(terms, k, candidates, count, &acc);
     for (const uint32_t wi : impl_->walls.near(pos)) {
       const WallSegment& wall = impl_->walls.walls()[wi];
       const glm::vec2 d = pos - closest_point_on_segment(pos, wall.a, wall.b);
@@ -285,7 +424,7 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     }
     glm::vec2 v_new = vel + acc * dt_s;
     const float s2 = glm::dot(v_new, v_new);
-    if (s2 > max_speed_[i] * max_speed_[i]) v_new *= max_speed_[i] / std::sqrt(s2);
+    if (s2 > max_speed * max_speed) v_new *= max_speed / std::sqrt(s2);
     if (!finite(v_new)) {
       impl_->non_finite.store(true, std::memory_order_relaxed);
       v_new = glm::vec2(0.0f);
@@ -308,7 +447,7 @@ void SocialForces::commit(size_t begin, size_t end, float dt_s) {
     if (s2 > max_speed_[i] * max_speed_[i]) vel *= max_speed_[i] / std::sqrt(s2);
     position_[i] = to;
     velocity_[i] = vel;
-    if (!arrived_[i] && glm::length(waypoints_[waypoint_[i]] - to) < goal_radius_[i]) {
+    if (!arrived_[i] && glm::length(goal_[i] - to) < goal_radius_[i]) {
       if (waypoint_[i] + 1 < waypoint_end_[i]) {
         ++waypoint_[i];
       } else {
@@ -319,6 +458,7 @@ void SocialForces::commit(size_t begin, size_t end, float dt_s) {
           arrived_[i] = 1;
         }
       }
+      goal_[i] = waypoints_[waypoint_[i]];
     }
     // Heading: exponential smoothing of the walking direction, slowed down in proportion to the
     // speed below heading_speed_m_s so that jitter of a standing agent does not spin it.
@@ -366,6 +506,7 @@ void SocialForces::remove_finished() {
       waypoint_[out] = waypoint_[i];
       waypoint_begin_[out] = waypoint_begin_[i];
       waypoint_end_[out] = waypoint_end_[i];
+      goal_[out] = goal_[i];
       loop_[out] = loop_[i];
       remove_at_goal_[out] = remove_at_goal_[i];
       attentive_[out] = attentive_[i];

@@ -10,9 +10,12 @@
 // a wall (the step is slid along the wall or cancelled) and agents are kept their radius away.
 //
 // One step is two whole-crowd passes over flat arrays: compute every new velocity from the frozen
-// state, then commit positions, waypoints and orientations. Each agent sums its neighbours in a
-// fixed order (uniform-grid cell order), so results do not depend on the thread count: runs with
-// threads = 2 equal threads = 1 bit for bit. Capacity and scratch are fixed at creation.
+// state, then commit positions, waypoints and orientations. The velocity pass walks the agents in
+// uniform-grid cell order over a packed copy of what it reads, so neighbours are contiguous in
+// memory, and computes the neighbour forces four at a time (SSE2, the same operations as one at a
+// time). Each agent sums its neighbours in a fixed order (cell order), so results do not depend on
+// the thread count: runs with threads = 2 equal threads = 1 bit for bit. Capacity and scratch are
+// fixed at creation.
 
 #include <cstdint>
 #include <memory>
@@ -90,6 +93,15 @@ class SocialForces final : public CrowdSource {
  private:
   struct Impl;
   SocialForces(const SocialForceParams& params, size_t capacity);
+  // What one agent's neighbour forces need of it.
+  struct AgentTerms {
+    glm::vec2 position, velocity, facing, right;
+    float radius;
+  };
+  void add_neighbour_force(const AgentTerms& a, size_t k, uint32_t m, glm::vec2* acc) const;
+  void add_neighbour_forces(const AgentTerms& a, size_t k, const uint32_t* candidates,
+                            uint32_t count, glm::vec2* acc) const;
+  void prepare(size_t begin, size_t end);
   void compute_velocities(size_t begin, size_t end, float dt_s);
   void commit(size_t begin, size_t end, float dt_s);
   void remove_finished();
@@ -110,13 +122,20 @@ class SocialForces final : public CrowdSource {
   std::vector<float> theta_, heading_;
   std::vector<float> desired_speed_, max_speed_, radius_, goal_radius_;
   std::vector<uint32_t> waypoint_, waypoint_begin_, waypoint_end_;  // current, chain [begin, end)
+  std::vector<glm::vec2> goal_;  // waypoints_[waypoint_[i]], kept beside it for sequential reads
   std::vector<uint8_t> loop_, remove_at_goal_, attentive_, arrived_, reached_;
   std::vector<glm::vec2> waypoints_;  // all chains, immutable
   std::vector<AttentionTarget> targets_;
-  // Scratch of one step.
+  // Scratch of one step. What the velocity pass reads of an agent, packed into one 32-byte record
+  // so that gathering it into cell order costs one cache line per agent: body_ in index order
+  // (written by a sequential pass), sorted_ in the grid's cell order.
+  struct Body {
+    glm::vec2 position, velocity;
+    glm::vec2 direction;  // desired direction e toward the current waypoint; 0 when arrived
+    float radius, desired_speed;
+  };
+  std::vector<Body> body_, sorted_;
   std::vector<glm::vec2> new_velocity_;
-  std::vector<glm::vec2> sorted_position_, sorted_velocity_;
-  std::vector<float> sorted_radius_;
 };
 
 }  // namespace gk

@@ -177,8 +177,11 @@ std::span<const uint32_t> WallGrid::near(glm::vec2 p) const {
 glm::vec2 WallGrid::constrain_move(glm::vec2 from, glm::vec2 to, float radius) const {
   const WallGrid& grid = *this;
   if (walls_.empty()) return to;
+  const std::span<const uint32_t> near_from = grid.near(from);
+  // No wall near `from` and a short move: nothing below can change `to` (the common case).
+  if (near_from.empty() && glm::length(to - from) + radius <= grid.reach()) return to;
   auto walls_for = [&](glm::vec2 target, float extra) {
-    return glm::length(target - from) + extra <= grid.reach() ? grid.near(from) : grid.all();
+    return glm::length(target - from) + extra <= grid.reach() ? near_from : grid.all();
   };
   auto crosses = [&](glm::vec2 target) {
     for (const uint32_t wi : walls_for(target, 0.0f)) {

@@ -464,6 +464,98 @@ TEST(WallGrid, ConstrainedMovesNeverCrossWalls) {
   EXPECT_GT(slid_or_stopped, 1000) << "the walls should have been in the way often";
 }
 
+// One step of a packed cluster against the model of social_forces.h written out here in double
+// precision. Every agent has about 100 neighbours within the cutoff (more than the simulator
+// buffers at once) and two agents share one spot (separated by id), so every path of the
+// neighbour sum is exercised.
+TEST(SocialForces, OneStepOfAPackedClusterFollowsTheModel) {
+  constexpr int kAgents = 101;
+  constexpr float kStep = 0.01f;
+  uint64_t state = 12345;
+  auto uniform = [&state](double lo, double hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * double(state >> 40) / double(1 << 24);
+  };
+  Scenario scenario;
+  scenario.bounds_min = glm::vec2(-10.0f);
+  scenario.bounds_max = glm::vec2(10.0f);
+  ScenarioAgents a;
+  std::vector<glm::vec2> velocities;
+  for (int i = 0; i < kAgents; ++i) {
+    const double r = 0.9 * std::sqrt(uniform(0.0, 1.0)), phi = uniform(0.0, 2.0 * kPi);
+    a.positions.emplace_back(i == 1 ? a.positions[0]  // agent 1 on agent 0's spot
+                                    : glm::vec2(r * std::cos(phi), r * std::sin(phi)));
+    a.desired_speeds_m_s.push_back(float(uniform(1.0, 1.4)));
+    a.radii_m.push_back(float(uniform(0.05, 0.2)));
+    a.waypoint_begin.push_back(uint32_t(i));
+    const double goal = uniform(0.0, 2.0 * kPi);
+    a.waypoints.emplace_back(8.0 * std::cos(goal), 8.0 * std::sin(goal));
+    a.loop_waypoints.push_back(0);
+    const double speed = uniform(0.0, 0.6), heading = uniform(0.0, 2.0 * kPi);
+    velocities.emplace_back(speed * std::cos(heading), speed * std::sin(heading));
+  }
+  a.waypoint_begin.push_back(uint32_t(kAgents));
+  const SocialForceParams params;
+  auto sim = SocialForces::create(scenario, a, params);
+  ASSERT_TRUE(sim.ok()) << sim.message();
+  const std::vector<uint8_t> all(kAgents, 1);
+  const std::vector<float> thetas(kAgents, 0.0f);
+  ASSERT_TRUE((*sim)->apply_feedback({all, a.positions, velocities, thetas}).ok());
+  ASSERT_TRUE((*sim)->step(kStep).ok());
+  const AgentFrame f = (*sim)->frame();
+  ASSERT_EQ(f.size(), size_t(kAgents));
+
+  const SocialForceParams& p = params;
+  int checked = 0;
+  for (int i = 0; i < kAgents; ++i) {
+    ASSERT_EQ(f.ids[i], uint32_t(i));
+    const glm::dvec2 pi(a.positions[i]), vi(velocities[i]);
+    const glm::dvec2 to_goal = glm::dvec2(a.waypoints[i]) - pi;
+    const glm::dvec2 e = to_goal / glm::length(to_goal);
+    glm::dvec2 acc = (double(a.desired_speeds_m_s[i]) * e - vi) / double(p.relaxation_time_s);
+    double magnitude = glm::length(acc);  // sum of the terms' sizes, for the tolerance
+    const glm::dvec2 facing = glm::length(vi) > 0.1 ? vi / glm::length(vi) : e;
+    const glm::dvec2 right(-facing.y, facing.x);
+    int neighbours = 0;
+    for (int j = 0; j < kAgents; ++j) {
+      const glm::dvec2 d = pi - glm::dvec2(a.positions[j]);
+      if (j == i || glm::dot(d, d) >= double(p.neighbour_radius_m) * p.neighbour_radius_m) continue;
+      ++neighbours;
+      const double dist = glm::length(d);
+      const glm::dvec2 n = dist > 0.0 ? d / dist : glm::dvec2(i < j ? -1.0 : 1.0, 0.0);
+      const double radii = double(a.radii_m[i]) + a.radii_m[j];
+      const double cos_phi = -glm::dot(n, facing);
+      const double lambda = p.field_of_view_weight;
+      const double w = lambda + (1.0 - lambda) * 0.5 * (1.0 + cos_phi);
+      const glm::dvec2 y = (glm::dvec2(velocities[j]) - vi) * double(p.anticipation_time_s);
+      const glm::dvec2 dy = d - y;
+      const double sum = dist + glm::length(dy);
+      const double b = 0.5 * std::sqrt(std::max(sum * sum - glm::dot(y, y), 0.0));
+      const double stretch = sum / (2.0 * std::max(b, 0.1 * sum + 1e-6));
+      const glm::dvec2 dir = 0.5 * (n + dy / glm::length(dy));
+      const double repulsion = p.agent_strength_m_s2 * std::exp((radii - b) / p.agent_range_m) *
+                               w * stretch;
+      acc += repulsion * dir;
+      magnitude += repulsion;
+      if (cos_phi > 0.0) acc += p.side_step * repulsion * cos_phi * right;
+      if (radii - dist > 0.0) {
+        acc += double(p.body_stiffness_s2) * (radii - dist) * n;
+        magnitude += double(p.body_stiffness_s2) * (radii - dist);
+      }
+    }
+    EXPECT_GE(neighbours, 80) << "agent " << i;
+    glm::dvec2 expected = vi + acc * double(kStep);
+    const double max_speed = double(p.max_speed_factor) * a.desired_speeds_m_s[i];
+    if (glm::length(expected) > max_speed) expected *= max_speed / glm::length(expected);
+    // Float sums, and a velocity read back from a float position step of 1 cm or less.
+    const double tolerance = 1e-5 * magnitude * kStep + 5e-5;
+    EXPECT_NEAR(f.velocities[i].x, expected.x, tolerance) << "agent " << i;
+    EXPECT_NEAR(f.velocities[i].y, expected.y, tolerance) << "agent " << i;
+    ++checked;
+  }
+  EXPECT_EQ(checked, kAgents);
+}
+
 // The uniform grid's 3x3-cell search finds exactly the pairs closer than a cell, as brute force.
 TEST(UniformGrid, NeighbourSearchMatchesBruteForce) {
   std::vector<glm::vec2> points;
