@@ -383,6 +383,12 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     float& t = st.time_s[slot];
     float& w = st.weight[slot];
     const float fade = dt / P.blend_time_s;
+    if (!play && stage != TransitionStage::kNone) {
+      // The mode left APM (set_params): its other modes switch clips at once.
+      stage = TransitionStage::kNone;
+      index = -1;
+      w = 0.0f;
+    }
     if (stop_seen) ++counts[kStopsSeen];
     if (start_seen) {
       ++counts[kStartsSeen];
