@@ -15,6 +15,10 @@
 namespace gk {
 namespace {
 
+// [sin of the angle] a limb closer to straight than this (2 deg) bends in the pole's plane.
+constexpr float kStraightLimb = 0.035f;
+constexpr float kPi = 3.14159265358979f;
+
 // nlerp on the shortest arc: cheaper than slerp and, between neighbouring frames,
 // indistinguishable.
 glm::quat nlerp_shortest(const glm::quat& a, const glm::quat& b, float t) {
@@ -325,14 +329,27 @@ void TwoBoneIKJob::run() const {
   const float ba_bc_1 =
       std::acos(clamp_unit((lat * lat - lab * lab - lcb * lcb) / (-2.0f * lab * lcb)));
 
-  // Bend plane normal: the current plane of the limb, or the pole plane when the limb is straight.
+  // Bend plane normal: the current plane of the limb, or the pole plane when the limb is straight
+  // or within 2 deg of it (its own plane may then point either way from frame to frame, and the
+  // twist toward the pole would turn the limb about itself by up to half a turn).
+  // In the pole's plane the limb's present bend counts by its share along that plane's normal
+  // (negative when it bends away from the pole): continuous as the limb straightens.
   glm::vec3 axis0 = glm::cross(ac_n, ab);
-  if (glm::length(axis0) < 1e-5f) axis0 = glm::cross(ac_n, pole);
+  float hip_0 = ac_ab_0, knee_0 = ba_bc_0;
+  const float own = glm::length(axis0);
+  const glm::vec3 pole_axis = glm::cross(ac_n, pole);
+  if (own < kStraightLimb && glm::length(pole_axis) >= 1e-5f) {
+    const glm::vec3 n = glm::normalize(pole_axis);
+    const float along = own > 1e-9f ? glm::dot(axis0 / own, n) : 0.0f;
+    hip_0 = along * ac_ab_0;
+    knee_0 = kPi - along * (kPi - ba_bc_0);
+    axis0 = n;
+  }
   if (glm::length(axis0) < 1e-5f) axis0 = glm::cross(ac_n, glm::vec3(1, 0, 0));
   axis0 = glm::normalize(axis0);
 
-  const glm::quat r_bend = glm::angleAxis(ac_ab_1 - ac_ab_0, axis0);
-  const glm::quat r_knee = glm::angleAxis(ba_bc_1 - ba_bc_0, axis0);
+  const glm::quat r_bend = glm::angleAxis(ac_ab_1 - hip_0, axis0);
+  const glm::quat r_knee = glm::angleAxis(ba_bc_1 - knee_0, axis0);
   // End joint after the bend, then swing the chain onto the target direction.
   const glm::vec3 c1 = a + r_bend * (b - a) + r_bend * (r_knee * (c - b));
   const glm::quat r_swing = rotation_between(c1 - a, target - a);

@@ -98,6 +98,14 @@ json to_json(const BenchReport& r) {
   } else {
     out["lod"] = nullptr;
   }
+  if (r.transitions) {
+    const BenchReport::Transitions& t = *r.transitions;
+    out["transitions"] = {{"starts", t.starts},           {"starts_played", t.starts_played},
+                          {"stops", t.stops},             {"stops_played", t.stops_played},
+                          {"start_clips", t.start_clips}, {"stop_clips", t.stop_clips}};
+  } else {
+    out["transitions"] = nullptr;
+  }
   out["render"] = r.render ? *r.render : json(nullptr);
   return out;
 }
@@ -148,6 +156,13 @@ std::string summary(const BenchReport& r) {
          " / " + fixed(l.mean_agents_per_level[2], 0) + " / " +
          fixed(l.mean_agents_per_level[3], 0) + ", updated per frame " +
          fixed(l.mean_agents_updated, 0) + "; metrics: level 0 agents only\n";
+  }
+  if (r.transitions) {
+    const BenchReport::Transitions& t = *r.transitions;
+    s += "  transitions (library: " + std::to_string(t.start_clips) + " start, " +
+         std::to_string(t.stop_clips) + " stop clips): starts " + std::to_string(t.starts) +
+         ", played " + std::to_string(t.starts_played) + "; stops " + std::to_string(t.stops) +
+         ", played " + std::to_string(t.stops_played) + "\n";
   }
   if (r.metrics) {
     const nlohmann::json& m = *r.metrics;

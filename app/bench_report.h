@@ -113,6 +113,14 @@ struct BenchReport {
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists
   std::optional<CrowdReport> crowd;
   std::optional<LodReport> lod;  // null without --lod
+  // Starts and stops the mediator saw (an agent's speed rising past the stop speed after standing
+  // a quarter second, or falling below it after moving as long), and how many played a start or
+  // stop clip of the library (transitions; none without takes that have them).
+  struct Transitions {
+    int64_t starts = 0, starts_played = 0, stops = 0, stops_played = 0;
+    int64_t start_clips = 0, stop_clips = 0;  // in the library
+  };
+  std::optional<Transitions> transitions;
   // --render: what was drawn (mesh levels, triangles, agents per level) and the render stage's
   // CPU time; null without --render.
   std::optional<nlohmann::json> render;

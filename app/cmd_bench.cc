@@ -415,6 +415,18 @@ void run_bench(const BenchOptions& o) {
   report.takes = describe_takes(library);
   report.left_out = describe_left_out(library);
   report.doubtful = describe_doubts(library);
+  {
+    BenchReport::Transitions t;
+    const auto counts = session->mediator().transition_counts();
+    t.starts = static_cast<int64_t>(counts[kStartsSeen]);
+    t.starts_played = static_cast<int64_t>(counts[kStartsPlayed]);
+    t.stops = static_cast<int64_t>(counts[kStopsSeen]);
+    t.stops_played = static_cast<int64_t>(counts[kStopsPlayed]);
+    for (const Transition& tr : library.transitions) {
+      ++(tr.kind == TransitionKind::kStart ? t.start_clips : t.stop_clips);
+    }
+    report.transitions = t;
+  }
   const MetricsReport measured = metrics.finish();
   report.metrics = metrics_to_json(measured, library);
   if (dump) {

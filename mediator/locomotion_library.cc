@@ -18,6 +18,10 @@
 namespace gk {
 namespace {
 
+// Standing kept beside a start or stop [s], and the shortest transition worth playing [s].
+constexpr float kTransitionRest = 0.4f;
+constexpr float kMinTransition = 0.5f;
+
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kMinGaitSpeed = 0.25f;  // [m/s] slower "gaits" are treated as standing clips
 constexpr float kMaxGaitSpeed = 12.0f;  // [m/s] faster ones are not locomotion
@@ -397,7 +401,124 @@ LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
   return idle;
 }
 
+
+// A take's stretch (a start or a stop, with its root motion) as a transition clip: facing turned
+// to +z, the root's travel taken out frame by frame along its path smoothed over a quarter
+// second (the pelvis keeps its sway), contacts and toe heights from clip analysis of the take's
+// stretch. `speed` gets that smoothed path's speed per frame.
+LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
+                                    std::vector<float>* speed) {
+  LocomotionClip lc;
+  lc.analysis = analyze_clip(span, sk);
+  lc.source = span;
+  lc.transition = true;
+  Clip c = span;
+  c.loops = false;
+  const int n = c.num_frames, nj = c.num_joints;
+  const int hips = sk.role(JointRole::kHips);
+  std::vector<glm::mat4> model(nj);
+  std::vector<glm::vec3> hips_xz(n);
+  for (int f = 0; f < n; ++f) {
+    clip_frame_model(c, sk, f, model);
+    hips_xz[f] = translation_of(model[hips]);
+    hips_xz[f].y = 0.0f;
+  }
+  const int half = std::max(1, static_cast<int>(std::lround(0.125f * c.fps)));
+  std::vector<glm::vec3> path(n);
+  for (int f = 0; f < n; ++f) {
+    // Centred on the frame (narrower near the ends, so the path does not lag there).
+    const int h = std::min({half, f, n - 1 - f});
+    glm::vec3 sum(0.0f);
+    for (int k = f - h; k <= f + h; ++k) sum += hips_xz[k];
+    path[f] = sum / static_cast<float>(2 * h + 1);
+  }
+  speed->assign(n, 0.0f);
+  for (int f = 0; f < n; ++f) {
+    const int a = std::max(0, f - 1), b = std::min(n - 1, f + 1);
+    const glm::vec3 d = path[b] - path[a];
+    (*speed)[f] = b > a ? std::hypot(d.x, d.z) * c.fps / static_cast<float>(b - a) : 0.0f;
+  }
+  const glm::quat yaw = glm::angleAxis(-clip_facing(c, sk), glm::vec3(0, 1, 0));
+  for (int f = 0; f < n; ++f) {
+    glm::quat& r = c.rotations[static_cast<size_t>(f) * nj];
+    glm::vec3& t = c.translations[static_cast<size_t>(f) * nj];
+    r = yaw * r;
+    t = yaw * (t - path[f]);
+  }
+  lc.clip = std::move(c);
+  lc.cycle_s = lc.clip.duration_s();
+  // Contacts as clip analysis finds them in the take. As for a gait clip, a lock may start only
+  // where the ball has come to rest over the ground (slower than half the root's speed, and never
+  // a stricter limit than contact analysis's), not while the heel strikes or the foot rolls off;
+  // it is kept through the contact while the ball is no faster than in 90% of those frames.
+  // Toe heights and swing progress as for a gait clip.
+  const FootTracks tracks = foot_tracks(lc.clip, sk);
+  const FootTracks world = foot_tracks(span, sk);  // with the take's root motion
+  const ContactThresholds ct;
+  for (int s = 0; s < 2; ++s) {
+    const std::vector<uint8_t> contact = contact_frames(lc.analysis, s, n, lc.clip.fps, false);
+    std::vector<float> ground(n, 0.0f);
+    for (int f = 0; f < n; ++f) {
+      const int a = std::max(0, f - 1), b = std::min(n - 1, f + 1);
+      const glm::vec3 d = world.toe[s][b] - world.toe[s][a];
+      ground[f] = b > a ? std::hypot(d.x, d.z) * lc.clip.fps / static_cast<float>(b - a) : 0.0f;
+    }
+    lc.plant[s].assign(n, 0);
+    lc.hold[s].assign(n, 0);
+    std::vector<float> rested;
+    for (int f = 0; f < n; ++f) {
+      const float rest =
+          std::max(ct.min_still_speed_m_s, ct.still_fraction_of_travel * (*speed)[f]);
+      lc.plant[s][f] = contact[f] && ground[f] <= rest;
+      if (lc.plant[s][f]) rested.push_back(ground[f]);
+    }
+    const float max_v = rested.empty() ? 0.0f : percentile(std::move(rested), 0.9);
+    for (int f = 0; f < n; ++f) {
+      lc.hold[s][f] = lc.plant[s][f] || (contact[f] && ground[f] <= max_v);
+    }
+    lc.toe_height_m[s].assign(n, 0.0f);
+    float min_t = 1e9f, min_a = 1e9f;
+    for (int f = 0; f < n; ++f) {
+      min_t = std::min(min_t, tracks.toe[s][f].y);
+      min_a = std::min(min_a, tracks.ankle[s][f].y);
+    }
+    for (int f = 0; f < n; ++f) lc.toe_height_m[s][f] = tracks.toe[s][f].y - min_t;
+    lc.toe_floor_m[s] = min_t;
+    lc.ankle_floor_m[s] = min_a;
+    lc.swing_progress[s].assign(n, 0.0f);
+    for (const auto& [first, len] : swing_runs(lc.plant[s], false)) {
+      for (int k = 0; k < len; ++k) lc.swing_progress[s][first + k] = (k + 0.5f) / len;
+    }
+  }
+  for (int f = 0; f < n; ++f) {
+    lc.double_support = lc.double_support || (lc.plant[0][f] && lc.plant[1][f]);
+  }
+  return lc;
+}
+
+// The gait phase at which a cycle's foot `side` lands (its contact begins), or -1 without one.
+float landing_phase(const LocomotionClip& cycle, int side) {
+  const float dur = cycle.clip.duration_s();
+  for (const TimeInterval& c : cycle.analysis.contacts[side]) {
+    float u = (c.start_s - cycle.phase_to_time[0]) / std::max(cycle.cycle_s, 1e-4f);
+    u -= std::floor(u);
+    if (cycle.clip.loops || c.start_s < dur) return u;
+  }
+  return -1.0f;
+}
 }  // namespace
+
+const char* transition_kind_name(TransitionKind kind) {
+  return kind == TransitionKind::kStart ? "start" : "stop";
+}
+
+float Transition::speed_at(float t_s) const {
+  if (speed_m_s.empty()) return 0.0f;
+  const float x = std::clamp(t_s * fps, 0.0f, static_cast<float>(speed_m_s.size() - 1));
+  const size_t i = std::min(static_cast<size_t>(x), speed_m_s.size() - 1);
+  const size_t j = std::min(i + 1, speed_m_s.size() - 1);
+  return speed_m_s[i] + (x - static_cast<float>(i)) * (speed_m_s[j] - speed_m_s[i]);
+}
 
 float LocomotionClip::time_at_phase(float phase) const {
   const float x = std::clamp(phase - std::floor(phase), 0.0f, 1.0f) * kPhaseTableSize;
@@ -696,6 +817,11 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     Clip loop, take;
   };
   std::vector<Fallback> fallbacks;
+  struct PendingTransition {
+    Clip span;
+    TransitionKind kind;
+  };
+  std::vector<PendingTransition> pending;
   // One clip of the library: analysed, made in place, classified as gait or standing.
   // `take`: the capture it was cut from, on a level floor (the metrics' reference; null for a
   // clip authored in place or a second cut of the same take).
@@ -811,6 +937,27 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         report.clips.push_back(still.name);
         add(std::move(still), nullptr);
       }
+      // Starts and stops: kept as transitions (made once the library's cycles are known), each
+      // with a little of the standing beside it (a start from rest, a stop that comes to rest).
+      for (size_t k = 0; k < seg.segments.size(); ++k) {
+        const TakeSegment& s = seg.segments[k];
+        if (s.kind != SegmentKind::kStart && s.kind != SegmentKind::kStop) continue;
+        const bool start = s.kind == SegmentKind::kStart;
+        const TakeSegment* idle = start ? (k > 0 ? &seg.segments[k - 1] : nullptr)
+                                        : (k + 1 < seg.segments.size() ? &seg.segments[k + 1]
+                                                                       : nullptr);
+        if (idle != nullptr && idle->kind != SegmentKind::kIdle) idle = nullptr;
+        TimeInterval span = s.span;
+        if (idle != nullptr) {
+          if (start) span.start_s = std::max(idle->span.start_s, span.start_s - kTransitionRest);
+          else span.end_s = std::min(idle->span.end_s, span.end_s + kTransitionRest);
+        }
+        if (span.end_s - span.start_s < kMinTransition) continue;
+        Clip cut = extract_span(clip, span);
+        cut.name += start ? " (start)" : " (stop)";
+        report.clips.push_back(cut.name);
+        pending.push_back({std::move(cut), start ? TransitionKind::kStart : TransitionKind::kStop});
+      }
       if (report.clips.empty() && seg.cycles.empty()) {
         leave_out(clip, "a take with no stride to loop and no standing stretch (see its segments)");
       }
@@ -884,6 +1031,98 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         synthesise_idle(lib.clips[lib.groups[lib.forward_group].clips.front()], sk));
   }
   lib.idle = static_cast<int>(lib.clips.size()) - 1;
+
+  // Transitions, after the standing clip: each joins the forward cycle nearest its moving speed,
+  // at the phase where that cycle's foot landed as long before as the transition's own did.
+  for (PendingTransition& p : pending) {
+    Transition tr;
+    tr.kind = p.kind;
+    LocomotionClip lc = make_transition_clip(p.span, sk, &tr.speed_m_s);
+    tr.fps = lc.clip.fps;
+    tr.duration_s = lc.clip.duration_s();
+    const bool start = p.kind == TransitionKind::kStart;
+    {
+      // Over its moving end's last (first) quarter second.
+      const int nf = static_cast<int>(tr.speed_m_s.size());
+      const int k = std::clamp(static_cast<int>(std::lround(0.25f * tr.fps)), 1, nf);
+      float sum = 0.0f;
+      for (int f = 0; f < k; ++f) sum += tr.speed_m_s[start ? nf - 1 - f : f];
+      tr.moving_speed_m_s = sum / static_cast<float>(k);
+    }
+    {
+      const float still = SegmentationThresholds{}.idle_speed_m_s;
+      const int nf = static_cast<int>(tr.speed_m_s.size());
+      int a = 0, b = nf - 1;
+      if (start) {
+        for (int f = 0; f < nf; ++f) {
+          if (tr.speed_m_s[f] < still) a = std::min(f + 1, nf - 1);
+        }
+      } else {
+        for (int f = nf - 1; f >= 0; --f) {
+          if (tr.speed_m_s[f] < still) b = std::max(f - 1, 0);
+        }
+      }
+      tr.moving_from_s = a / tr.fps;
+      tr.moving_to_s = b / tr.fps;
+    }
+    // The moving end's landing: a start's last contact to begin, a stop's first (one that
+    // begins after the stretch's first frame, so it is a landing, not the cut).
+    const float frame = 1.0f / tr.fps;
+    int side = -1;
+    float land = 0.0f;
+    for (int s = 0; s < 2; ++s) {
+      for (const TimeInterval& c : lc.analysis.contacts[s]) {
+        if (c.start_s < 0.5f * frame) continue;
+        if (side < 0 || (start ? c.start_s > land : c.start_s < land)) {
+          side = s;
+          land = c.start_s;
+        }
+      }
+    }
+    // The lead foot: a start's first to lift off, a stop's last to land.
+    if (start) {
+      float lift = 1e9f;
+      for (int s = 0; s < 2; ++s) {
+        for (const TimeInterval& c : lc.analysis.contacts[s]) {
+          if (c.end_s < tr.duration_s - 0.5f * frame && c.end_s < lift) {
+            lift = c.end_s;
+            tr.lead_foot = s;
+          }
+        }
+      }
+    } else {
+      float last = -1.0f;
+      for (int s = 0; s < 2; ++s) {
+        for (const TimeInterval& c : lc.analysis.contacts[s]) {
+          if (c.start_s > last) {
+            last = c.start_s;
+            tr.lead_foot = s;
+          }
+        }
+      }
+    }
+    const DirectionGroup& fg = lib.groups[lib.forward_group];
+    float best = 1e9f;
+    for (int c : fg.clips) {
+      const float d = std::abs(lib.clips[c].speed_m_s - tr.moving_speed_m_s);
+      if (d < best) {
+        best = d;
+        tr.cycle_clip = c;
+      }
+    }
+    const float lp = side >= 0 ? landing_phase(lib.clips[tr.cycle_clip], side) : -1.0f;
+    if (lp < 0.0f || tr.moving_speed_m_s < kMinGaitSpeed) {
+      leave_out(lc.clip, std::string("a ") + transition_kind_name(p.kind) +
+                             " whose moving end has no landing or no speed to join a cycle at");
+      continue;
+    }
+    const float cycle_s = lib.clips[tr.cycle_clip].cycle_s;
+    float phase = start ? lp + (tr.duration_s - land) / cycle_s : lp - land / cycle_s;
+    tr.cycle_phase = phase - std::floor(phase);
+    tr.clip = static_cast<int>(lib.clips.size());
+    lib.clips.push_back(std::move(lc));
+    lib.transitions.push_back(std::move(tr));
+  }
 
   // One floor for every clip: captures (and actors) stand at different heights, so each clip is
   // raised or lowered until its flat feet stand where the clips' flat feet stand on the median.

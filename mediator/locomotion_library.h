@@ -52,7 +52,39 @@ struct LocomotionClip {
   // contacts: pinning a foot where the clip is not standing makes legs snap, which is worse than
   // the clip's own motion.
   std::vector<std::string> doubts;
+  // A start or stop cut from a take (LocomotionLibrary::transitions): played on its own clock,
+  // never in the blend space (it is neither `gait` nor the standing clip). Its root travel is
+  // taken out frame by frame (not at one mean speed), so the pose keeps only the pelvis's sway.
+  bool transition = false;
   float time_at_phase(float phase) const;  // phase in [0, 1)
+};
+
+// A start (standing -> steady gait) or a stop (steady gait -> standing) found in a take, kept as
+// a transition the mediator plays when an agent starts or stops (mediator_passes.h,
+// transition_pass).
+enum class TransitionKind : uint8_t { kStart, kStop };
+const char* transition_kind_name(TransitionKind kind);
+struct Transition {
+  TransitionKind kind = TransitionKind::kStart;
+  int clip = -1;             // its clip in LocomotionLibrary::clips (LocomotionClip::transition)
+  float duration_s = 0.0f;
+  float fps = 30.0f;
+  // The root's speed along its path [m/s] per clip frame (smoothed over a quarter second): what
+  // the playback rate follows, so the clip's feet move with the agent.
+  std::vector<float> speed_m_s;
+  float moving_speed_m_s = 0.0f;  // over its moving end: a start's last or a stop's first 0.25 s
+  // The steady cycle (forward, nearest in speed) a start hands over to or a stop takes over from,
+  // and that cycle's gait phase at the transition's moving end (matched on the foot contacts:
+  // the same foot landed as long ago).
+  int cycle_clip = -1;
+  float cycle_phase = 0.0f;
+  // Side of the foot that leads: a start's first foot to leave the ground, a stop's last to land.
+  int lead_foot = 0;
+  // Clip time [s] where its root moves: a start's last and a stop's first frame below the
+  // standing speed (0.15 m/s, as take segmentation) lies before / after it.
+  float moving_from_s = 0.0f;
+  float moving_to_s = 0.0f;
+  float speed_at(float t_s) const;  // speed_m_s between frames, held beyond the ends
 };
 
 // What the library made of a take with root motion: its segments and the clips cut from it.
@@ -100,6 +132,15 @@ struct LocomotionLibrary {
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;
   std::vector<TakeReport> takes;  // takes with root motion, as segmented
+  // Starts and stops cut from the takes (none for clips authored as loops, such as the built-in
+  // set): their clips are in `clips`, marked `transition`, after the standing clip.
+  std::vector<Transition> transitions;
+  bool has_transitions(TransitionKind kind) const {
+    for (const Transition& t : transitions) {
+      if (t.kind == kind) return true;
+    }
+    return false;
+  }
   // Clips of the given sets that are not in the library and why (a standing clip without
   // contacts, a name that says it is no locomotion, ...): reported, never silent.
   struct LeftOut {

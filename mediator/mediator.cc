@@ -63,10 +63,19 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   scratch_target_.assign(capacity * nc, 0.0f);
   idle_time_.assign(capacity, 0.0f);
   cadence_scale_.assign(capacity, 1.0f);
+  tr_index_.assign(capacity, -1);
+  tr_stage_.assign(capacity, TransitionStage::kNone);
+  for (auto* v : {&tr_time_, &tr_weight_, &tr_waited_, &tr_lag_, &tr_prev_speed_, &tr_prev_phase_,
+                  &tr_still_, &tr_moving_}) {
+    v->assign(capacity, 0.0f);
+  }
+  tr_rate_.assign(capacity, 1.0f);
+  tr_counts_.assign(capacity * kNumCounts, 0);
   lod_plan_.assign(capacity, 1);
   lod_dt_s_.assign(capacity, 0.0f);
   lod_elapsed_s_.assign(capacity, 0.0f);
   lod_phase_advance_.assign(capacity, 0.0f);
+  lod_tr_advance_.assign(capacity, 0.0f);
   lod_root_at_plan_.assign(capacity, glm::vec2(0.0f));
 }
 
@@ -231,8 +240,12 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                pl.layer_weight, pl.blend_progress);
   rate_phase_pass(crowd, pl.layer_clip, pl.layer_weight, pl.speed_m_s, cadence_scale_, pl.lower_yaw,
                   pl.phase, idle_time_, pl.playback_rate, pl.gait_weight, pl.travel_yaw);
-  contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, pl.gait_weight,
-                pl.layer_time_s,
+  transition_pass(crowd, pl.speed_m_s, pl.standing, pl.layer_clip, pl.layer_weight,
+                  pl.gait_weight, pl.phase,
+                  {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_lag_,
+                   tr_prev_speed_, tr_prev_phase_, tr_still_, tr_moving_, tr_counts_});
+  contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, tr_time_,
+                pl.gait_weight, pl.layer_time_s,
                 {{pl.plant[0], pl.plant[1]},
                  {pl.hold[0], pl.hold[1]},
                  {pl.swing_progress[0], pl.swing_progress[1]},
@@ -247,14 +260,15 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
       const int slot = pl.slot_of_agent[i];
       if (!lod_plan_[slot]) continue;
       lod_root_at_plan_[slot] = pl.root_xz[slot];
-      lod_elapsed_s_[slot] = lod_phase_advance_[slot] = 0.0f;
+      lod_elapsed_s_[slot] = lod_phase_advance_[slot] = lod_tr_advance_[slot] = 0.0f;
     }
   }
   return Status::Ok();
 }
 
-// LOD: the agent's phase, clip times and idle clock advance with the rate of its last plan, and
-// its root follows p as the root pass's would (pulled_root). Clips, weights, facing and springs wait for its next plan.
+// LOD: the agent's phase, clip times, idle clock and transition clock advance with the rates of
+// its last plan, and its root follows p as the root pass's would (pulled_root). Clips, weights,
+// facing and springs wait for its next plan.
 void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const glm::vec2& v_in,
                              float theta_in, float dt) {
   AnimationPlans& pl = plans_;
@@ -284,9 +298,25 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
   }
   idle_time_[slot] += dt;
   lod_elapsed_s_[slot] += dt;
-  for (int k = 0; k < kMaxBlendLayers; ++k) {
-    lt[k] = layer_time(library_.clips[lc[k]], pl.phase[slot], idle_time_[slot]);
+  // A transition's clock, at its last rate.
+  const TransitionStage stage = tr_stage_[slot];
+  if (stage == TransitionStage::kPlaying || stage == TransitionStage::kLeaving) {
+    const float before = tr_time_[slot];
+    const float end = library_.transitions[tr_index_[slot]].duration_s;
+    tr_time_[slot] = std::min(before + tr_rate_[slot] * dt, end);
+    lod_tr_advance_[slot] += tr_time_[slot] - before;
   }
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    lt[k] = layer_time(library_.clips[lc[k]], pl.phase[slot], idle_time_[slot], tr_time_[slot]);
+  }
+}
+
+std::array<uint64_t, kNumCounts> Mediator::transition_counts() const {
+  std::array<uint64_t, kNumCounts> sum{};
+  for (size_t slot = 0; slot < capacity_; ++slot) {
+    for (int k = 0; k < kNumCounts; ++k) sum[k] += tr_counts_[slot * kNumCounts + k];
+  }
+  return sum;
 }
 
 // LOD: the step [s] a due agent is planned over: the time since its last plan. The phase, idle
@@ -299,6 +329,7 @@ float Mediator::lod_step(int slot, float dt) {
   phase -= std::fmod(lod_phase_advance_[slot], 1.0f);
   if (phase < 0.0f) phase += 1.0f;
   idle_time_[slot] -= lod_elapsed_s_[slot];
+  tr_time_[slot] -= lod_tr_advance_[slot];
   plans_.root_xz[slot] = lod_root_at_plan_[slot];
   return std::min(elapsed, 1.0f);
 }

@@ -7,8 +7,9 @@
 // All per-agent data lives in slots (structure of arrays) sized for the crowd's capacity at
 // construction; plan() allocates nothing. It validates the frame, assigns slots, then runs the
 // whole-crowd passes of mediator/mediator_passes.h in order (filter, root, facing, weights, rate
-// and phase, contacts, feedback), each over every agent in parallel.
+// and phase, transitions, contacts, feedback), each over every agent in parallel.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "mediator/animation_plans.h"
 #include "mediator/id_map.h"
 #include "mediator/locomotion_library.h"
+#include "mediator/mediator_passes.h"
 #include "mediator/params.h"
 
 namespace gk {
@@ -68,6 +70,14 @@ class Mediator {
   const MediatorParams& params() const { return params_; }
   void set_params(const MediatorParams& p);
   bool degraded() const { return degraded_; }
+  // Starts and stops seen since construction and how many played a transition clip (indexed by
+  // TransitionCount; mediator_passes.h): summed over the slots.
+  std::array<uint64_t, kNumCounts> transition_counts() const;
+  // Per slot: the transition playing (index into library().transitions, -1: none), its clip time
+  // [s] and layer weight.
+  int transition_of_slot(int slot) const { return tr_index_[slot]; }
+  float transition_time_of_slot(int slot) const { return tr_time_[slot]; }
+  float transition_weight_of_slot(int slot) const { return tr_weight_[slot]; }
   // Agents whose input had to be sanitised (NaN or speeds above 15 m/s) since construction.
   uint64_t num_sanitised() const { return num_sanitised_; }
   // Sim-side velocity of agent i of the last frame (for the feedback metric).
@@ -110,6 +120,13 @@ class Mediator {
   std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
   std::vector<float> idle_time_;           // clock of the standing clip
   std::vector<float> cadence_scale_;       // per-agent variety
+  // Transitions (mediator_passes.h, TransitionState).
+  std::vector<int16_t> tr_index_;
+  std::vector<TransitionStage> tr_stage_;
+  std::vector<float> tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_lag_, tr_prev_speed_,
+      tr_prev_phase_;
+  std::vector<float> tr_still_, tr_moving_;
+  std::vector<uint32_t> tr_counts_;  // [slot * kNumCounts + k]
   // Per slot, scratch between passes.
   std::vector<float> root_heading_;    // root pass -> facing pass
   std::vector<float> rel_dir_;         // facing pass -> weights pass
@@ -119,7 +136,7 @@ class Mediator {
   std::span<const uint8_t> lod_due_;
   std::vector<uint8_t> lod_plan_;
   std::vector<float> lod_dt_s_;
-  std::vector<float> lod_elapsed_s_, lod_phase_advance_;
+  std::vector<float> lod_elapsed_s_, lod_phase_advance_, lod_tr_advance_;
   std::vector<glm::vec2> lod_root_at_plan_;
 };
 

@@ -312,10 +312,230 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
   });
 }
 
+namespace {
+
+// The transition an agent starts or stops with: the one of `kind` whose moving speed is nearest
+// `speed` (-1: the library has none).
+int nearest_transition(const LocomotionLibrary& lib, TransitionKind kind, float speed) {
+  int best = -1;
+  float best_d = 0.0f;
+  for (size_t i = 0; i < lib.transitions.size(); ++i) {
+    const Transition& t = lib.transitions[i];
+    if (t.kind != kind) continue;
+    const float d = std::abs(t.moving_speed_m_s - speed);
+    if (best < 0 || d < best_d) {
+      best = static_cast<int>(i);
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+// True when the phase passed `target` going from `from` to `to` (forward, less than a cycle).
+bool phase_passed(float from, float to, float target) {
+  float span = to - from;
+  if (span < 0.0f) span += 1.0f;
+  float off = target - from;
+  if (off < 0.0f) off += 1.0f;
+  return off <= span && span < 0.5f;
+}
+
+}  // namespace
+
+void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
+                     std::span<const uint8_t> standing, std::span<int16_t> layer_clip,
+                     std::span<float> layer_weight, std::span<float> gait_weight,
+                     std::span<float> phase, TransitionState st) {
+  const LocomotionLibrary& lib = c.library;
+  const MediatorParams& P = c.params;
+  const bool play = is_apm(c) && !lib.transitions.empty();
+  const float kStill = SegmentationThresholds{}.idle_speed_m_s;  // [m/s] a root this slow stands
+  constexpr float kLagCatchUp = 0.3f;  // [s] a transition's clip makes up its root's lag this fast
+  for_each_agent(c, [&](size_t, int slot) {
+    const float dt = c.dt(slot);
+    const float v = speed_m_s[slot];
+    const bool stand = standing[slot] != 0;
+    uint32_t* counts = &st.counts[static_cast<size_t>(slot) * kNumCounts];
+    if (c.fresh[slot]) {
+      st.index[slot] = -1;
+      st.stage[slot] = TransitionStage::kNone;
+      st.weight[slot] = st.time_s[slot] = st.waited_s[slot] = st.lag_m[slot] = 0.0f;
+      st.rate[slot] = 1.0f;
+      st.still_s[slot] = st.moving_s[slot] = 0.0f;
+      st.prev_speed_m_s[slot] = v;
+      st.prev_phase[slot] = phase[slot];
+      return;
+    }
+    const float accel = (v - st.prev_speed_m_s[slot]) / dt;
+    const float prev_phase = st.prev_phase[slot];
+    st.prev_speed_m_s[slot] = v;
+    const bool start_seen = !stand && st.still_s[slot] >= kTransitionSettle;
+    const bool stop_seen = stand && st.moving_s[slot] >= kTransitionSettle;
+    if (stand) {
+      st.still_s[slot] += dt;
+      st.moving_s[slot] = 0.0f;
+    } else {
+      st.moving_s[slot] += dt;
+      st.still_s[slot] = 0.0f;
+    }
+    TransitionStage& stage = st.stage[slot];
+    int16_t& index = st.index[slot];
+    float& t = st.time_s[slot];
+    float& w = st.weight[slot];
+    const float fade = dt / P.blend_time_s;
+    if (!play && stage != TransitionStage::kNone) {
+      // The mode left APM (set_params): its other modes switch clips at once.
+      stage = TransitionStage::kNone;
+      index = -1;
+      w = 0.0f;
+    }
+    if (stop_seen) ++counts[kStopsSeen];
+    if (start_seen) {
+      ++counts[kStartsSeen];
+      // Played unless a stop is still playing or fading out (one waiting for its phase gives way).
+      const int k = play ? nearest_transition(lib, TransitionKind::kStart, v) : -1;
+      if (k >= 0 && (stage == TransitionStage::kNone || stage == TransitionStage::kWaiting)) {
+        const Transition& tr = lib.transitions[k];
+        index = static_cast<int16_t>(k);
+        stage = TransitionStage::kPlaying;
+        w = 0.0f;
+        // From where the clip moves as fast as the agent (its rest before that is skipped).
+        t = tr.moving_from_s;
+        while (t < tr.moving_to_s && tr.speed_at(t) < v) t += 1.0f / tr.fps;
+        st.lag_m[slot] = 0.0f;
+        ++counts[kStartsPlayed];
+      }
+    }
+    if (play && stage == TransitionStage::kNone && !stand &&
+        st.moving_s[slot] >= kTransitionSettle && accel < -kStopDeceleration) {
+      // Slowing down: a stop when the speed, falling as it does, reaches rest within the stop
+      // clip's own stopping time (with some slack), from a speed the clip walks at.
+      // It is entered where the clip has slowed to the agent's speed (a slow agent plays only
+      // the stop's last steps).
+      const int k = nearest_transition(lib, TransitionKind::kStop, v);
+      if (k >= 0) {
+        const Transition& tr = lib.transitions[k];
+        float entry = tr.moving_from_s;
+        while (entry < tr.moving_to_s && tr.speed_at(entry) > v) entry += 1.0f / tr.fps;
+        const float to_rest = v / -accel;
+        if (to_rest <= 1.25f * (tr.moving_to_s - entry) + 0.2f &&
+            v <= 1.3f * tr.moving_speed_m_s && entry < tr.moving_to_s) {
+          index = static_cast<int16_t>(k);
+          stage = TransitionStage::kWaiting;
+          st.waited_s[slot] = 0.0f;
+          t = entry;
+          w = 0.0f;
+        }
+      }
+    }
+    if (stage == TransitionStage::kNone) {
+      st.prev_phase[slot] = phase[slot];
+      return;
+    }
+    const Transition& tr = lib.transitions[index];
+    const LocomotionClip& cycle = lib.clips[tr.cycle_clip];
+    const bool start = tr.kind == TransitionKind::kStart;
+    if (stage == TransitionStage::kWaiting) {
+      // The stop begins on the gait phase its first landing matches; it is given up if the agent
+      // speeds up again, stands before that phase comes, or the phase does not come within a
+      // cycle (the agent is not walking).
+      st.waited_s[slot] += dt;
+      float entry_phase = tr.cycle_phase + (t - tr.moving_from_s) / cycle.cycle_s;
+      entry_phase -= std::floor(entry_phase);
+      if (accel > 0.0f || stand || st.waited_s[slot] > cycle.cycle_s + 0.1f) {
+        stage = TransitionStage::kNone;
+        index = -1;
+      } else if (phase_passed(prev_phase, phase[slot], entry_phase)) {
+        stage = TransitionStage::kPlaying;
+        float late = phase[slot] - entry_phase;
+        if (late < 0.0f) late += 1.0f;
+        t += late * cycle.cycle_s;
+        st.lag_m[slot] = 0.0f;
+        w = 0.0f;
+      }
+      if (stage != TransitionStage::kPlaying) {
+        st.prev_phase[slot] = phase[slot];
+        return;
+      }
+    } else {
+      // The clock: the agent's speed over the clip's root speed, within the rate limits (where
+      // both stand, the clip settles at its own pace).
+      const float clip_v = tr.speed_at(t);
+      float rate = 1.0f;
+      if (clip_v >= kStill || v >= kStill) {
+        // The agent's speed, plus what the clip's root has fallen behind it (made up over
+        // kLagCatchUp), over the clip's.
+        const float wanted = v + st.lag_m[slot] / kLagCatchUp;
+        rate = std::clamp(wanted / std::max(clip_v, 0.05f), P.min_playback_rate,
+                          P.max_playback_rate);
+        // A stop whose clip still walks faster than the agent hurries on to where it is as slow.
+        if (!start && clip_v > 1.15f * v + 0.05f) rate = P.max_playback_rate;
+      }
+      st.rate[slot] = rate;
+      const float t_next = std::min(t + rate * dt, tr.duration_s);
+      st.lag_m[slot] += v * dt - clip_v * (t_next - t);
+      t = t_next;
+    }
+    if (stage == TransitionStage::kPlaying) {
+      // Left when it is nearly over (a start hands over to the cycle while the clip still walks,
+      // a stop once the clip stands), or when the agent does the opposite of what it plays.
+      const bool over = start ? t >= tr.duration_s - P.blend_time_s * st.rate[slot]
+                              : t >= tr.duration_s - P.blend_time_s;
+      // A stop is also left when the agent walks on faster than the clip can follow.
+      const float reach = tr.speed_at(t) * P.max_playback_rate + kStill;
+      // A start is left when the agent stops again or creeps on slower than the clip can go.
+      const bool creeps = tr.speed_at(t) * P.min_playback_rate > v + kStill;
+      const bool aborted =
+          start ? stand || creeps
+                : !stand && ((accel > kStopDeceleration && v > 0.5f * tr.moving_speed_m_s) ||
+                             v > reach);
+      if (over || aborted) stage = TransitionStage::kLeaving;
+    }
+    if (stop_seen && !start) ++counts[kStopsPlayed];  // the agent comes to rest in a stop clip
+    w = stage == TransitionStage::kPlaying ? std::min(1.0f, w + fade) : std::max(0.0f, w - fade);
+    if (stage == TransitionStage::kLeaving && w <= 0.0f) {
+      stage = TransitionStage::kNone;
+      index = -1;
+      st.prev_phase[slot] = phase[slot];
+      return;
+    }
+    // The gait phase follows the transition's clock: the cycle joins (or leaves) in step.
+    const float joint_s = start ? tr.duration_s : tr.moving_from_s;  // the phase is cycle_phase
+    const float ph = tr.cycle_phase + (t - joint_s) / cycle.cycle_s;
+    phase[slot] = ph - std::floor(ph);
+    st.prev_phase[slot] = phase[slot];
+    // The transition's layer takes a free one (a forward-only blend fills at most two of them,
+    // plus clips fading out); until one is free its weight waits at 0 (a layer dropped at once
+    // would pop), then the others share 1 - w.
+    int16_t* lc = &layer_clip[slot * kMaxBlendLayers];
+    float* lw = &layer_weight[slot * kMaxBlendLayers];
+    int k_min = 0;
+    for (int l = 1; l < kMaxBlendLayers; ++l) {
+      if (lw[l] < lw[k_min]) k_min = l;
+    }
+    if (lw[k_min] > 1e-4f && w <= fade) {
+      w = 0.0f;
+      return;
+    }
+    lw[k_min] = 0.0f;
+    float rest = 0.0f;
+    for (int l = 0; l < kMaxBlendLayers; ++l) rest += lw[l];
+    float gait = 0.0f;
+    for (int l = 0; l < kMaxBlendLayers; ++l) {
+      lw[l] = rest > 0.0f ? lw[l] * (1.0f - w) / rest : 0.0f;
+      if (l != k_min && lib.clips[lc[l]].gait) gait += lw[l];
+    }
+    lc[k_min] = static_cast<int16_t>(tr.clip);
+    lw[k_min] = rest > 0.0f ? w : 1.0f;
+    gait_weight[slot] = gait;
+  });
+}
+
 void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                    std::span<const float> layer_weight, std::span<const float> phase,
-                   std::span<const float> idle_time_s, std::span<const float> gait_weight,
-                   std::span<float> out_layer_time_s, ContactPlans out) {
+                   std::span<const float> idle_time_s, std::span<const float> transition_time_s,
+                   std::span<const float> gait_weight, std::span<float> out_layer_time_s,
+                   ContactPlans out) {
   const LocomotionLibrary& lib = c.library;
   for_each_agent(c, [&](size_t, int slot) {
     const int16_t* lc = &layer_clip[slot * kMaxBlendLayers];
@@ -328,10 +548,14 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     // swings.
     float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
     float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, walk = 0.0f;
-    const bool gait_votes = gait_w >= 0.25f;
+    float moving_w = gait_w;  // gait clips and a transition: they vote without the standing clip
+    for (int k = 0; k < kMaxBlendLayers; ++k) {
+      if (lib.clips[lc[k]].transition) moving_w += lw[k];
+    }
+    const bool gait_votes = moving_w >= 0.25f;
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       const LocomotionClip& clip = lib.clips[lc[k]];
-      lt[k] = layer_time(clip, phase[slot], idle_time_s[slot]);
+      lt[k] = layer_time(clip, phase[slot], idle_time_s[slot], transition_time_s[slot]);
       if (lw[k] <= 0.0f) continue;
       const int nf = clip.clip.num_frames;
       auto wrap = [&](int i) {
@@ -350,7 +574,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
           toe_gait[s] += lw[k] * (hv + clip.toe_floor_m[s]);
         }
       }
-      if (gait_votes && !clip.gait) continue;
+      if (gait_votes && !clip.gait && !clip.transition) continue;
       vote_w += lw[k];
       if (clip.double_support) walk += lw[k];
       for (int s = 0; s < 2; ++s) {

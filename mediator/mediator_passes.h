@@ -7,6 +7,7 @@
 //   facing    lower-body yaw (psi), upper-body yaw, travel direction relative to psi
 //   weights   target clip weights, faded, cut to the heaviest kMaxBlendLayers layers
 //   rate      playback rate and gait phase
+//   transition  a start or stop clip as a layer on its own clock (libraries that have them)
 //   contacts  clip times, plant / hold / swing progress of each foot, the gait clips' toe height
 //   feedback  what the animation can deliver, for the simulator     (per slot -> per agent)
 //
@@ -76,8 +77,11 @@ inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const 
   return out;
 }
 
-// A layer's clip time: a gait clip's at the shared gait phase, a standing clip's on its clock.
-inline float layer_time(const LocomotionClip& clip, float phase, float idle_time_s) {
+// A layer's clip time: a gait clip's at the shared gait phase, a standing clip's on its clock, a
+// transition's on its own (`transition_time_s`).
+inline float layer_time(const LocomotionClip& clip, float phase, float idle_time_s,
+                        float transition_time_s) {
+  if (clip.transition) return transition_time_s;
   return clip.gait ? clip.time_at_phase(phase)
                    : std::fmod(idle_time_s, std::max(clip.clip.duration_s(), 1e-3f));
 }
@@ -166,6 +170,52 @@ void rate_phase_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip
                      std::span<float> out_playback_rate, std::span<float> out_gait_weight,
                      std::span<float> out_travel_yaw);
 
+// --- transitions --------------------------------------------------------------------------------
+// Per slot, carried: the start or stop clip an agent plays (LocomotionLibrary::transitions) as a
+// layer of its own, on its own clock.
+enum class TransitionStage : uint8_t {
+  kNone,     // nothing playing
+  kWaiting,  // a stop chosen, waiting for the gait phase its first contacts match
+  kPlaying,  // fading in or at full weight
+  kLeaving,  // fading out: a start handing over to the cycle, a stop at rest, or an abort
+};
+// What transition_counts() sums: starts and stops seen and how many played a transition clip.
+enum TransitionCount : int { kStartsSeen, kStartsPlayed, kStopsSeen, kStopsPlayed, kNumCounts };
+struct TransitionState {
+  std::span<int16_t> index;  // into library.transitions, -1: none
+  std::span<TransitionStage> stage;
+  std::span<float> time_s;    // clip time [s]
+  std::span<float> weight;    // layer weight, 0..1
+  std::span<float> rate;      // clip-time step / real time
+  std::span<float> waited_s;  // time waited for the phase [s]
+  std::span<float> lag_m;     // playing: the agent's distance travelled minus the clip's [m]
+  std::span<float> prev_speed_m_s, prev_phase;
+  std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
+  std::span<uint32_t> counts;          // [slot * kNumCounts + TransitionCount], cumulative
+};
+// The agent has stood (or moved) at least this long before a start (stop) counts.
+inline constexpr float kTransitionSettle = 0.25f;  // [s]
+// A stop is chosen when the speed falls at least this fast [m/s^2]; a playing stop is left when
+// it rises this fast.
+inline constexpr float kStopDeceleration = 0.3f;
+
+// Reads the filtered speed, `standing`, the layers and phase, and last frame's transition state.
+// Counts starts (speed rising past the stop speed after standing kTransitionSettle) and stops
+// (falling below it after moving as long). In APM, with a library that has them, plays them: a
+// start as the agent starts, from the clip time where the clip moves as fast as the agent; a stop
+// once the speed falls fast enough to come to rest within the clip's own stopping time, entered
+// where the clip has slowed to the agent's speed and begun when the gait phase reaches the one
+// the stop's contacts match there. The clock runs at the agent's speed over the clip's root
+// speed, corrected so that the clip's root travels as far as the agent does (within the rate
+// limits); the gait phase follows the clock so the cycle joins in step. A start the agent does not
+// keep up with, or a stop it walks out of, fades out early. Writes the transition's layer (in a
+// free layer, the others sharing 1 - its weight), the gait share and the phase. A library without
+// transitions changes nothing.
+void transition_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
+                     std::span<const uint8_t> standing, std::span<int16_t> layer_clip,
+                     std::span<float> layer_weight, std::span<float> gait_weight,
+                     std::span<float> phase, TransitionState state);
+
 // --- contacts -----------------------------------------------------------------------------------
 // Per slot, per foot: what the clips do with each foot this frame.
 struct ContactPlans {
@@ -175,13 +225,15 @@ struct ContactPlans {
   std::span<float> gait_toe_y[2];      // the gait clips' own toe height [m]
   std::span<float> double_support;     // share of the voting clips that walk, 0..1
 };
-// Reads the layers, the phase, the standing clip's clock and the share of gait clips. Writes each
-// layer's clip time (phase-synchronised: a new clip starts in phase) and the feet's contacts,
-// voted by the gait clips alone once they carry a quarter of the blend.
+// Reads the layers, the phase, the standing clip's and the transition's clocks and the share of
+// gait clips. Writes each layer's clip time (phase-synchronised: a new clip starts in phase) and
+// the feet's contacts, voted by the gait clips (and a transition) alone once they carry a quarter
+// of the blend.
 void contacts_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
                    std::span<const float> layer_weight, std::span<const float> phase,
-                   std::span<const float> idle_time_s, std::span<const float> gait_weight,
-                   std::span<float> out_layer_time_s, ContactPlans out);
+                   std::span<const float> idle_time_s, std::span<const float> transition_time_s,
+                   std::span<const float> gait_weight, std::span<float> out_layer_time_s,
+                   ContactPlans out);
 
 // --- feedback -----------------------------------------------------------------------------------
 // Per agent, index-aligned with the frame.

@@ -325,6 +325,43 @@ TEST(TwoBoneIKJob, ReachesRandomTargetsWithKneeTowardPole) {
   EXPECT_EQ(reached, 200);
 }
 
+// A limb within a hair of straight (bent half a degree either way, as a captured stance leg at
+// push-off) bends toward the pole: its own bend plane is no guide, and taking it turned the limb
+// about itself by up to half a turn whenever the hair's bend pointed away from the pole.
+TEST(TwoBoneIKJob, NearlyStraightLimbBendsTowardThePole) {
+  const Skeleton s = make_chain(3, 0.4f);
+  for (const float bend_deg : {0.5f, -0.5f}) {
+    std::vector<glm::quat> r(3, glm::quat(1, 0, 0, 0));
+    r[1] = glm::angleAxis(glm::radians(bend_deg), glm::vec3(1, 0, 0));
+    std::vector<glm::mat4> m(3);
+    LocalToModelJob fk{&s, r, s.rest_translations, glm::mat4(1), m};
+    fk.run();
+    const glm::vec3 hip = translation_of(m[0]);
+    const glm::vec3 target = hip + glm::normalize(translation_of(m[2]) - hip) * 0.7f;
+    const glm::vec3 pole(0, 0, 1);
+    glm::quat c0, c1;
+    TwoBoneIKJob ik;
+    ik.start_model = m[0];
+    ik.mid_model = m[1];
+    ik.end_model = m[2];
+    ik.target = target;
+    ik.pole = pole;
+    ik.out_start_correction = &c0;
+    ik.out_mid_correction = &c1;
+    ik.run();
+    r[0] = r[0] * c0;
+    r[1] = r[1] * c1;
+    fk.run();
+    EXPECT_LT(glm::length(translation_of(m[2]) - target), 1e-3f) << bend_deg;
+    const glm::vec3 axis = glm::normalize(target - hip);
+    glm::vec3 knee = translation_of(m[1]) - hip;
+    knee -= axis * glm::dot(knee, axis);
+    EXPECT_GT(glm::dot(knee, pole), 0.0f) << bend_deg;
+    // The hip turns by about the knee's bend (30 deg at 0.7 of 0.8 m), not about the limb.
+    EXPECT_LT(2.0f * std::acos(std::min(1.0f, std::abs(c0.w))), glm::radians(45.0f)) << bend_deg;
+  }
+}
+
 TEST(TwoBoneIKJob, OutOfReachStretchesTowardTarget) {
   const Skeleton s = make_chain(3, 0.4f);
   std::vector<glm::quat> r(3, glm::quat(1, 0, 0, 0));

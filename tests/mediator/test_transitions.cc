@@ -1,0 +1,174 @@
+// Starts and stops played from real transition clips (issue #10, item 2): the library keeps the
+// start and stop found in the subject-16 takes as transitions, and an agent that starts from rest
+// or comes to rest plays them, its feet planted and its root where the simulator has it. A
+// library without transitions plays none.
+
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "mediator/mediator.h"
+#include "tests/mediator/mediator_fixture.h"
+#include "tests/test_data.h"
+
+namespace gk {
+namespace {
+
+constexpr float kDt = 1.0f / 60.0f;
+
+// The steady walk, the start take and the stop take of subject 16.
+Result<LocomotionLibrary> start_stop_library() {
+  return test::load_data_library({"clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+                                  "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh",
+                                  "clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh"});
+}
+
+// Stands for 1 s, speeds up to 1.2 m/s over 1.2 s (along +z), walks on.
+glm::vec2 starting(double t) {
+  const double u = std::clamp((t - 1.0) / 1.2, 0.0, 1.0);
+  return {0.0f, static_cast<float>(1.2 * u * u * (3.0 - 2.0 * u))};
+}
+// Walks at 1.1 m/s for 2 s, slows to rest over 1.2 s, stands.
+glm::vec2 stopping(double t) {
+  const double u = std::clamp((t - 2.0) / 1.2, 0.0, 1.0);
+  return {0.0f, static_cast<float>(1.1 * (1.0 - u * u * (3.0 - 2.0 * u)))};
+}
+
+struct Played {
+  MetricsReport report;
+  std::array<uint64_t, kNumCounts> counts{};
+  int frames_with[2] = {0, 0};  // frames a start / stop clip had weight (as a layer)
+  float max_weight[2] = {0.0f, 0.0f};
+  int pops = 0;
+};
+
+Played play(const LocomotionLibrary& lib, glm::vec2 (*velocity)(double), int frames) {
+  test::ScriptedCrowd crowd({{glm::vec2(0.0f), velocity, nullptr}});
+  CrowdPipeline pipeline(lib, MediatorParams{}, test::test_pipeline_options(1, kDt));
+  Played out;
+  for (int f = 0; f < frames; ++f) {
+    const Status s = pipeline.step(crowd, kDt);
+    EXPECT_TRUE(s.ok()) << s.message();
+    const AnimationPlans& pl = pipeline.mediator().plans();
+    const int slot = pl.slot_of_agent[0];
+    // A pop (METRICS.md): a joint turning further in a frame than twice the clips ever do.
+    if (pipeline.poses().max_rotation_change(slot) > 2.0f * lib.max_rotation_step_rad) ++out.pops;
+    for (int k = 0; k < kMaxBlendLayers; ++k) {
+      const int clip = pl.layer_clip[slot * kMaxBlendLayers + k];
+      const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
+      if (!lib.clips[clip].transition || w <= 0.0f) continue;
+      const auto it = std::find_if(lib.transitions.begin(), lib.transitions.end(),
+                                   [&](const Transition& t) { return t.clip == clip; });
+      EXPECT_NE(it, lib.transitions.end()) << "a transition clip played that no transition owns";
+      if (it == lib.transitions.end()) continue;
+      const int kind = it->kind == TransitionKind::kStart ? 0 : 1;
+      ++out.frames_with[kind];
+      out.max_weight[kind] = std::max(out.max_weight[kind], w);
+      // Its clock stays within the clip.
+      const float t = pl.layer_time_s[slot * kMaxBlendLayers + k];
+      EXPECT_GE(t, 0.0f);
+      EXPECT_LE(t, it->duration_s + 1e-4f);
+    }
+  }
+  out.report = pipeline.metrics()->finish();
+  out.counts = pipeline.mediator().transition_counts();
+  return out;
+}
+
+TEST(Transitions, TheSubject16TakesGiveAStartAndAStop) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  int starts = 0, stops = 0;
+  for (const Transition& t : lib->transitions) {
+    const bool start = t.kind == TransitionKind::kStart;
+    (start ? starts : stops) += 1;
+    ASSERT_GE(t.clip, 0);
+    ASSERT_LT(t.clip, static_cast<int>(lib->clips.size()));
+    const LocomotionClip& c = lib->clips[t.clip];
+    EXPECT_TRUE(c.transition);
+    EXPECT_FALSE(c.gait);  // never in the blend space
+    for (const DirectionGroup& g : lib->groups) {
+      EXPECT_EQ(std::count(g.clips.begin(), g.clips.end(), t.clip), 0);
+    }
+    EXPECT_NE(t.clip, lib->idle);
+    EXPECT_NEAR(t.duration_s, c.clip.duration_s(), 1e-4f);
+    EXPECT_EQ(t.speed_m_s.size(), static_cast<size_t>(c.clip.num_frames));
+    // The speed profile goes from rest to a walk (start) or from a walk to rest (stop).
+    const float rest = t.speed_m_s[start ? 0 : t.speed_m_s.size() - 1];
+    EXPECT_LT(rest, 0.3f) << c.clip.name;
+    EXPECT_GT(t.moving_speed_m_s, 0.8f) << c.clip.name;
+    EXPECT_LT(t.moving_from_s, t.moving_to_s);
+    // It joins a forward cycle at a phase in [0, 1).
+    ASSERT_GE(t.cycle_clip, 0);
+    EXPECT_TRUE(lib->clips[t.cycle_clip].gait);
+    EXPECT_GE(t.cycle_phase, 0.0f);
+    EXPECT_LT(t.cycle_phase, 1.0f);
+    EXPECT_TRUE(t.lead_foot == 0 || t.lead_foot == 1);
+    // Its feet have contacts to lock on.
+    EXPECT_GT(std::count(c.plant[0].begin(), c.plant[0].end(), 1), 0);
+    EXPECT_GT(std::count(c.plant[1].begin(), c.plant[1].end(), 1), 0);
+  }
+  EXPECT_GE(starts, 1);
+  EXPECT_GE(stops, 1);
+}
+
+TEST(Transitions, TheBuiltinLibraryHasNone) {
+  EXPECT_TRUE(test::builtin_library().transitions.empty());
+  for (const LocomotionClip& c : test::builtin_library().clips) EXPECT_FALSE(c.transition);
+}
+
+TEST(Transitions, AnAgentStartingFromRestPlaysTheStartClip) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const Played p = play(*lib, starting, 300);
+  EXPECT_EQ(p.counts[kStartsSeen], 1u);
+  EXPECT_EQ(p.counts[kStartsPlayed], 1u);
+  EXPECT_EQ(p.counts[kStopsSeen], 0u);
+  EXPECT_GT(p.frames_with[0], 20);
+  EXPECT_FLOAT_EQ(p.max_weight[0], 1.0f);
+  EXPECT_EQ(p.frames_with[1], 0);
+  EXPECT_LE(p.report.root_error_cm.mean, 3.0);
+  EXPECT_LE(p.report.feet.support_slide_cm_s, 2.0);
+  EXPECT_EQ(p.report.playback_outside_limits, 0.0);
+  EXPECT_EQ(p.pops, 0);
+}
+
+TEST(Transitions, AnAgentComingToRestPlaysTheStopClip) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const Played p = play(*lib, stopping, 300);
+  EXPECT_EQ(p.counts[kStopsSeen], 1u);
+  EXPECT_EQ(p.counts[kStopsPlayed], 1u);
+  EXPECT_EQ(p.counts[kStartsSeen], 0u);
+  EXPECT_GT(p.frames_with[1], 20);
+  EXPECT_FLOAT_EQ(p.max_weight[1], 1.0f);
+  EXPECT_EQ(p.frames_with[0], 0);
+  EXPECT_LE(p.report.root_error_cm.mean, 3.0);
+  EXPECT_LE(p.report.feet.support_slide_cm_s, 2.0);
+  EXPECT_EQ(p.report.playback_outside_limits, 0.0);
+  EXPECT_EQ(p.pops, 0);
+}
+
+// The same library with its transitions taken away: starts and stops are counted, none is played,
+// no transition clip ever gets weight, and the plans are those of the blend alone.
+TEST(Transitions, WithoutTransitionsNothingIsPlayed) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  LocomotionLibrary bare = *lib;
+  bare.transitions.clear();
+  for (auto velocity : {starting, stopping}) {
+    const Played p = play(bare, velocity, 300);
+    EXPECT_EQ(p.counts[kStartsSeen] + p.counts[kStopsSeen], 1u);
+    EXPECT_EQ(p.counts[kStartsPlayed] + p.counts[kStopsPlayed], 0u);
+    EXPECT_EQ(p.frames_with[0] + p.frames_with[1], 0);
+    EXPECT_LE(p.report.root_error_cm.mean, 3.0);
+  }
+}
+
+}  // namespace
+}  // namespace gk
