@@ -60,17 +60,24 @@ float leg_length(const Skeleton& sk, const std::vector<glm::mat4>& rest, Side s)
 
 // Removes the clip's mean travel from the root and turns its facing to +z (about the origin), so
 // the pose keeps only the pelvis's own sway and bob.
-Clip make_in_place(const Clip& src, const Skeleton& sk, const ClipAnalysis& a, float facing_rad) {
-  Clip c = src;
-  const int n = c.num_frames, nj = c.num_joints;
+// The hips' ground track (y = 0) of every frame of a clip.
+std::vector<glm::vec3> hips_ground_track(const Clip& c, const Skeleton& sk) {
   const int hips = sk.role(JointRole::kHips);
-  std::vector<glm::mat4> model(nj);
-  std::vector<glm::vec3> hips_xz(n);
-  for (int f = 0; f < n; ++f) {
+  std::vector<glm::mat4> model(c.num_joints);
+  std::vector<glm::vec3> hips_xz(c.num_frames);
+  for (int f = 0; f < c.num_frames; ++f) {
     clip_frame_model(c, sk, f, model);
     hips_xz[f] = translation_of(model[hips]);
     hips_xz[f].y = 0.0f;
   }
+  return hips_xz;
+}
+
+Clip make_in_place(const Clip& src, const Skeleton& sk, const ClipAnalysis& a, float facing_rad) {
+  Clip c = src;
+  const int n = c.num_frames, nj = c.num_joints;
+  std::vector<glm::mat4> model(nj);
+  const std::vector<glm::vec3> hips_xz = hips_ground_track(c, sk);
   // Travel: mean velocity of the hips (zero for in-place clips), centred on the mean position.
   const glm::vec3 vel =
       a.in_place || n < 2 ? glm::vec3(0.0f) : (hips_xz[n - 1] - hips_xz[0]) * (c.fps / (n - 1));
@@ -415,14 +422,8 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
   Clip c = span;
   c.loops = false;
   const int n = c.num_frames, nj = c.num_joints;
-  const int hips = sk.role(JointRole::kHips);
   std::vector<glm::mat4> model(nj);
-  std::vector<glm::vec3> hips_xz(n);
-  for (int f = 0; f < n; ++f) {
-    clip_frame_model(c, sk, f, model);
-    hips_xz[f] = translation_of(model[hips]);
-    hips_xz[f].y = 0.0f;
-  }
+  const std::vector<glm::vec3> hips_xz = hips_ground_track(c, sk);
   const int half = std::max(1, static_cast<int>(std::lround(0.125f * c.fps)));
   std::vector<glm::vec3> path(n);
   for (int f = 0; f < n; ++f) {
