@@ -82,6 +82,9 @@ class PoseSynthesizer {
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
+  // Asks the caches for what posing the slot reads first: its planned clips' frames and its pose
+  // arrays (a hint, issued one agent ahead).
+  void prefetch_agent(const AnimationPlans& pl, int slot) const;
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
   void fk(int slot, int from, int to, const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
@@ -118,6 +121,15 @@ class PoseSynthesizer {
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   std::vector<int> subtree_end_;  // subtree_ends(skeleton_)
   JointRange leg_range_[2];       // per side, what moves when leg IK turns the hip and the knee
+  // leg_range_ without its ankle's subtree when that is the range's tail (the feet are posed again
+  // once the ankles are restored), else leg_range_.
+  JointRange leg_above_ankle_[2];
+  // The spine twist's range (the spine chain's first joint's subtree) and the joints in it that
+  // the twist reads before it changes them (the chain, the chest and their ancestors in it): the
+  // rest of the range is posed once, after the twist.
+  bool can_twist_ = false;
+  JointRange twist_range_;
+  std::vector<int16_t> pre_twist_joints_;
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
 };
