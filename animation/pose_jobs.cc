@@ -133,40 +133,24 @@ bool SampleClipJob::validate() const {
          clip->translations.size() == n * clip->num_frames && std::isfinite(time_s);
 }
 
-ClipFramePair clip_frame_pair(const Clip& clip, float time_s) {
-  const int frames = clip.num_frames;
-  float f = time_s * clip.fps;
-  ClipFramePair p;
-  if (clip.loops) {
-    f = std::fmod(f, static_cast<float>(frames));
-    if (f < 0.0f) f += frames;
-    p.i0 = std::min(static_cast<int>(f), frames - 1);
-    p.i1 = (p.i0 + 1) % frames;
-  } else {
-    f = std::clamp(f, 0.0f, static_cast<float>(frames - 1));
-    p.i0 = std::min(static_cast<int>(f), frames - 1);
-    p.i1 = std::min(p.i0 + 1, frames - 1);
-  }
-  p.t = f - p.i0;
-  return p;
-}
-
-void prefetch_clip_frames(const Clip& clip, float time_s) {
-  if (clip.num_frames <= 0 || !std::isfinite(time_s)) return;
-  const ClipFramePair p = clip_frame_pair(clip, time_s);
-  const size_t n = static_cast<size_t>(clip.num_joints);
-  prefetch_bytes(clip.frame_rotations(p.i0), n * sizeof(glm::quat));
-  prefetch_bytes(clip.frame_rotations(p.i1), n * sizeof(glm::quat));
-  prefetch_bytes(clip.frame_translations(p.i0), n * sizeof(glm::vec3));
-  prefetch_bytes(clip.frame_translations(p.i1), n * sizeof(glm::vec3));
-}
-
 void SampleClipJob::run() const {
   const int n = clip->num_joints;
   const int frames = clip->num_frames;
-  const ClipFramePair fp = clip_frame_pair(*clip, time_s);
-  const int i0 = fp.i0, i1 = fp.i1;
-  const float t = fp.t;
+  float f = time_s * clip->fps;
+  int i0, i1;
+  float t;
+  if (clip->loops) {
+    f = std::fmod(f, static_cast<float>(frames));
+    if (f < 0.0f) f += frames;
+    i0 = std::min(static_cast<int>(f), frames - 1);
+    i1 = (i0 + 1) % frames;
+    t = f - i0;
+  } else {
+    f = std::clamp(f, 0.0f, static_cast<float>(frames - 1));
+    i0 = std::min(static_cast<int>(f), frames - 1);
+    i1 = std::min(i0 + 1, frames - 1);
+    t = f - i0;
+  }
   const glm::quat* r0 = clip->frame_rotations(i0);
   const glm::quat* r1 = clip->frame_rotations(i1);
   const glm::vec3* p0 = clip->frame_translations(i0);

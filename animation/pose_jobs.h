@@ -28,18 +28,6 @@ struct SampleClipJob {
   void run() const;
 };
 
-// The two frames a clip is sampled between at time_s and the fraction t between them, as
-// SampleClipJob samples it (clip non-empty, fps > 0).
-struct ClipFramePair {
-  int i0 = 0, i1 = 0;
-  float t = 0.0f;
-};
-ClipFramePair clip_frame_pair(const Clip& clip, float time_s);
-
-// Asks the caches for the two frames SampleClipJob reads at time_s (a hint, ahead of sampling:
-// the frames of an agent's clips are rarely cached and their fetch otherwise stalls the sampling).
-void prefetch_clip_frames(const Clip& clip, float time_s);
-
 // One input of a blend: a local pose and its weight (weights need not sum to 1; they are
 // normalised; layers with weight <= 0 are skipped).
 struct PoseLayer {

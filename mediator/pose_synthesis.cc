@@ -183,7 +183,6 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 32), [&](const tbb::blocked_range<size_t>& r) {
     Scratch& s = scratch.local();
     for (size_t i = r.begin(); i < r.end(); ++i) {
-      if (i + 1 < r.end()) prefetch_agent(pl, pl.slot_of_agent[i + 1]);
       synthesize_agent(pl, P, pl.slot_of_agent[i], dt_s, s);
     }
   });
@@ -195,12 +194,6 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 32), [&](const tbb::blocked_range<size_t>& r) {
     Scratch& s = scratch.local();
     for (size_t i = r.begin(); i < r.end(); ++i) {
-      if (i + 1 < r.end()) {
-        const int next = pl.slot_of_agent[i + 1];
-        if (static_cast<PoseDetail>(detail[next]) != PoseDetail::kHold || pl.fresh[next]) {
-          prefetch_agent(pl, next);
-        }
-      }
       const int slot = pl.slot_of_agent[i];
       const auto d = static_cast<PoseDetail>(detail[slot]);
       if (d == PoseDetail::kHold && !pl.fresh[slot]) {
@@ -210,20 +203,6 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
       }
     }
   });
-}
-
-void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot) const {
-  for (int k = 0; k < kMaxBlendLayers; ++k) {
-    const size_t l = static_cast<size_t>(slot) * kMaxBlendLayers + k;
-    if (pl.layer_weight[l] <= 0.0f) continue;
-    prefetch_clip_frames(library_.clips[pl.layer_clip[l]].clip, pl.layer_time_s[l]);
-  }
-  const size_t J = num_joints_;
-  const size_t base = static_cast<size_t>(slot) * J;
-  prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
-  prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
-  prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
-  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
 }
 
 // An agent not posed this frame: its world joints, palette and foot positions move with the

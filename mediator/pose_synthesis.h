@@ -82,9 +82,6 @@ class PoseSynthesizer {
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
-  // Asks the caches for what posing the slot reads first: its planned clips' frames and its pose
-  // arrays (a hint, issued one agent ahead).
-  void prefetch_agent(const AnimationPlans& pl, int slot) const;
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
   void fk(int slot, int from, int to, const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
