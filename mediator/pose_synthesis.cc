@@ -146,6 +146,30 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
       r = {std::max(0, std::min(hip, knee)), num_joints_};
     }
   }
+  for (Side side : {Side::kLeft, Side::kRight}) {
+    const int sd = static_cast<int>(side);
+    const JointRange foot = subtree(skeleton_.ankle(side));
+    leg_above_ankle_[sd] = leg_range_[sd];
+    if (foot.from < foot.to && foot.from >= leg_range_[sd].from && foot.to == leg_range_[sd].to) {
+      leg_above_ankle_[sd].to = foot.from;
+    }
+  }
+  const std::vector<int16_t>& chain = skeleton_.spine_chain;
+  const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
+  can_twist_ = !chain.empty() && hips >= 0 && chest >= 0;  // as twist_spine requires
+  if (can_twist_) {
+    twist_range_ = subtree(chain.front());
+    std::vector<uint8_t> read(J, 0);
+    auto mark = [&](int j) {  // j and its ancestors inside the range
+      for (; j >= twist_range_.from && j < twist_range_.to; j = skeleton_.parents[j]) read[j] = 1;
+    };
+    for (int16_t j : chain) mark(j);
+    mark(hips);
+    mark(chest);
+    for (int j = twist_range_.from; j < twist_range_.to; ++j) {
+      if (read[j]) pre_twist_joints_.push_back(static_cast<int16_t>(j));
+    }
+  }
   affine_inverse_bind_ = is_affine(inverse_bind_);
   // A crowd's palettes far larger than the caches are written past them (read only by the
   // upload, after the whole crowd is posed); a small crowd's stay cached for it.
@@ -290,8 +314,16 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   placed_xz_[slot] = pl.root_xz[slot];
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
-  fk(slot, 0, num_joints_, root);
-  if (apm && detail != PoseDetail::kLight) {
+  const bool twisting = apm && detail != PoseDetail::kLight;
+  if (twisting && can_twist_) {
+    // The twist poses its whole range again: before it, only the joints it reads there.
+    fk(slot, 0, twist_range_.from, root);
+    for (int16_t j : pre_twist_joints_) fk(slot, j, j + 1, root);
+    fk(slot, twist_range_.to, num_joints_, root);
+  } else {
+    fk(slot, 0, num_joints_, root);
+  }
+  if (twisting) {
     twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
   if (locking) lock_feet(pl, P, slot, root, dt);
@@ -538,8 +570,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     local_rot_[base + hip] = glm::normalize(local_rot_[base + hip] * c_hip);
     local_rot_[base + knee] = glm::normalize(local_rot_[base + knee] * c_knee);
   }
-  fk_ranges(slot, use_ik[0] ? leg_range_[0] : JointRange{},
-            use_ik[1] ? leg_range_[1] : JointRange{}, placed);
+  fk_ranges(slot, use_ik[0] ? leg_above_ankle_[0] : JointRange{},
+            use_ik[1] ? leg_above_ankle_[1] : JointRange{}, placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet.
   for (int side = 0; side < 2; ++side) {
     const Side sd = static_cast<Side>(side);

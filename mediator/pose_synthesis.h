@@ -118,6 +118,15 @@ class PoseSynthesizer {
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   std::vector<int> subtree_end_;  // subtree_ends(skeleton_)
   JointRange leg_range_[2];       // per side, what moves when leg IK turns the hip and the knee
+  // leg_range_ without its ankle's subtree when that is the range's tail (the feet are posed again
+  // once the ankles are restored), else leg_range_.
+  JointRange leg_above_ankle_[2];
+  // The spine twist's range (the spine chain's first joint's subtree) and the joints in it that
+  // the twist reads before it changes them (the chain, the chest and their ancestors in it): the
+  // rest of the range is posed once, after the twist.
+  bool can_twist_ = false;
+  JointRange twist_range_;
+  std::vector<int16_t> pre_twist_joints_;
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
 };

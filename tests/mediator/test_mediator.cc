@@ -287,6 +287,39 @@ TEST(Mediator, AgentsComeAndGo) {
   }
 }
 
+// Pose synthesis poses some joints twice and some once (the spine twist's range after the twist,
+// the feet after leg IK): whatever the path, every joint's world transform must be its parent's
+// times its final local rotation, or a joint was left behind from an earlier pass or frame.
+TEST(Mediator, WorldJointsFollowTheirFinalLocalRotations) {
+  const LocomotionLibrary& lib = builtin_library();
+  const Skeleton& sk = *lib.skeleton;
+  Mediator m(lib, MediatorParams{}, 4);
+  PoseSynthesizer ps(lib, 4, true);
+  const uint32_t ids[4] = {1, 2, 3, 4};
+  const glm::vec2 v[4] = {{0, 0.6f}, {0, 1.3f}, {0.4f, 2.6f}, {0, 0}};
+  const float th[4] = {0.9f, -0.7f, 0.3f, 1.2f};  // looking aside: the spine twists
+  glm::vec2 p[4] = {{0, 0}, {2, 0}, {4, 0}, {6, 0}};
+  constexpr float kDt = 1.0f / 60.0f;
+  for (int f = 0; f < 90; ++f) {
+    for (int i = 0; i < 4; ++i) p[i] += v[i] * kDt;
+    ASSERT_TRUE(m.plan(AgentFrame{ids, p, v, th}, kDt).ok());
+    ps.run(m.plans(), m.num_agents(), m.params(), kDt);
+    for (int i = 0; i < 4; ++i) {
+      const int slot = m.plans().slot_of_agent[i];
+      const std::span<const glm::mat4> w = ps.world(slot);
+      const std::span<const glm::quat> local = ps.local_rotations(slot);
+      for (int j = 0; j < sk.num_joints(); ++j) {
+        const int parent = sk.parents[j];
+        if (parent < 0) continue;
+        const glm::quat rel = glm::quat_cast(glm::mat3(glm::inverse(w[parent]) * w[j]));
+        ASSERT_GT(std::abs(glm::dot(glm::normalize(rel), local[j])), 1.0f - 1e-5f)
+            << "frame " << f << ", agent " << i << ", joint " << sk.names[j];
+      }
+    }
+  }
+  EXPECT_GT(std::abs(ps.torsion(m.plans().slot_of_agent[0])), 0.1f);  // the twist path ran
+}
+
 // Issue #11: plan() checks the whole frame before it writes anything. Before, a repeated newcomer
 // id was found after num_agents_, slot_of_agent and the id map (vanished agents erased) had been
 // written: the app then drew half-written plans, and the next good frame restarted agents.
