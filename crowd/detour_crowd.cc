@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -102,6 +103,8 @@ class DetourCrowdSource final : public CrowdSource {
   // Per agent; agent i is dtCrowd pool index i and has id i.
   std::vector<uint32_t> ids_;
   std::vector<glm::vec2> positions_, velocities_;
+  std::vector<glm::vec2> before_;  // positions before a Detour update
+  float max_step_speed_factor_ = 2.0f;
   std::vector<float> thetas_;
   std::vector<uint32_t> waypoint_begin_, waypoint_end_, waypoint_current_;
   std::vector<uint8_t> loop_;
@@ -137,6 +140,10 @@ Status DetourCrowdSource::init(const Scenario& scenario, const ScenarioAgents& a
   if (!std::isfinite(params.max_accel_m_s2) || params.max_accel_m_s2 <= 0.0f) {
     return Status::AtField(file, "max_accel_m_s2", "expected a finite acceleration > 0");
   }
+  if (!std::isfinite(params.max_step_speed_factor)) {
+    return Status::AtField(file, "max_step_speed_factor", "expected a finite number (<= 0: off)");
+  }
+  max_step_speed_factor_ = params.max_step_speed_factor;
   if (params.avoidance_quality < 0 || params.avoidance_quality > 3) {
     return Status::AtField(file, "avoidance_quality", "expected 0, 1, 2 or 3");
   }
@@ -206,6 +213,7 @@ Status DetourCrowdSource::init(const Scenario& scenario, const ScenarioAgents& a
   ids_.resize(n);
   positions_.resize(n);
   velocities_.assign(n, glm::vec2(0.0f));
+  before_.assign(n, glm::vec2(0.0f));
   thetas_.assign(n, 0.0f);
   waypoint_begin_.resize(n);
   waypoint_end_.resize(n);
@@ -310,8 +318,39 @@ Status DetourCrowdSource::step(float dt_s) {
   const int substeps =
       std::clamp(static_cast<int>(std::ceil(dt_s / kMaxSubstep_s)), 1, kMaxSubsteps);
   const float h = dt_s / static_cast<float>(substeps);
+  // Detour's collision resolution can push an agent in a packed jam, or against a wall corner, by
+  // 20 cm in one step (12 m/s): a body cannot be moved that fast, and a drawn body that follows it
+  // jumps. Each update's displacement is held to max_step_speed_factor times the agent's own
+  // maximum speed (the push is still felt, over several steps), sliding along the navmesh.
+  const float jump_cap = max_step_speed_factor_;
   for (int s = 0; s < substeps; ++s) {
+    if (jump_cap > 0.0f) {
+      for (size_t i = 0; i < ids_.size(); ++i) {
+        const dtCrowdAgent* ag = crowd_->getAgent(static_cast<int>(i));
+        before_[i] = glm::vec2(ag->npos[0], ag->npos[2]);
+      }
+    }
     crowd_->update(h, nullptr);
+    if (jump_cap > 0.0f) {
+      const dtQueryFilter* filter = crowd_->getFilter(0);
+      for (size_t i = 0; i < ids_.size(); ++i) {
+        if (!alive_[i]) continue;
+        dtCrowdAgent* ag = crowd_->getEditableAgent(static_cast<int>(i));
+        if (!ag->active || ag->state != DT_CROWDAGENT_STATE_WALKING) continue;
+        const glm::vec2 d = glm::vec2(ag->npos[0], ag->npos[2]) - before_[i];
+        const float cap = jump_cap * ag->params.maxSpeed * h;
+        const float len = glm::length(d);
+        if (len <= cap) continue;
+        const glm::vec2 to = before_[i] + d * (cap / len);
+        const float target[3] = {to.x, ag->npos[1], to.y};
+        if (ag->corridor.movePosition(target, query_.get(), filter)) {
+          const float* pos = ag->corridor.getPos();
+          ag->npos[0] = pos[0];
+          ag->npos[1] = pos[1];
+          ag->npos[2] = pos[2];
+        }
+      }
+    }
     advance_waypoints();
   }
   time_s_ += dt_s;

@@ -26,6 +26,9 @@ struct DetourParams {
   // Velocity-obstacle sampling: 0 low, 1 medium, 2 good, 3 high [Limit: 0..3]. More candidate
   // velocities per agent: smoother avoidance, higher cost per step.
   int avoidance_quality = 3;
+  // An agent moves at most this many times its maximum speed in an update, collision pushes
+  // included (<= 0: as Detour moves it; a jam's push can otherwise move it 20 cm in a step).
+  float max_step_speed_factor = 2.0f;
   uint64_t seed = 1;  // unused: DetourCrowd has no randomness
 };
 

@@ -323,5 +323,54 @@ TEST(DetourCrowd, RunsEveryScenarioFile) {
   EXPECT_GT(num_files, 0);
 }
 
+// The bottleneck jam at 60 Hz: Detour's collision pushes move some agents by far more than they
+// can walk in a step (an agent pushed 20 cm in a frame makes its drawn body jump). With the cap,
+// no agent moves more than max_step_speed_factor times its top speed in a step. Returns the
+// largest displacement per step over the agent's top speed step, over 600 steps.
+float largest_step_over_walk(float factor) {
+  const std::filesystem::path file = test::source_path("data/scenarios/bottleneck.json");
+  Result<Scenario> loaded = load_scenario(file.string());
+  EXPECT_TRUE(loaded.ok()) << loaded.message();
+  const int n = loaded->default_agents;
+  const Scenario scenario = scale_scenario(*loaded, n);
+  Result<ScenarioAgents> agents = expand_agents(scenario, n, 1);
+  EXPECT_TRUE(agents.ok()) << agents.message();
+  DetourParams params;
+  params.max_step_speed_factor = factor;
+  auto made = make_detour_crowd(scenario, *agents, params);
+  EXPECT_TRUE(made.ok()) << made.message();
+  CrowdSource& crowd = **made;
+  constexpr float kStep = 1.0f / 60.0f;
+  std::vector<glm::vec2> prev(crowd.frame().positions.begin(), crowd.frame().positions.end());
+  std::vector<uint32_t> ids(crowd.frame().ids.begin(), crowd.frame().ids.end());
+  float worst = 0.0f;
+  for (int step = 0; step < 600; ++step) {
+    EXPECT_TRUE(crowd.step(kStep).ok());
+    const AgentFrame f = crowd.frame();
+    std::vector<glm::vec2> now(f.positions.begin(), f.positions.end());
+    std::vector<uint32_t> now_ids(f.ids.begin(), f.ids.end());
+    for (size_t i = 0; i < now.size(); ++i) {
+      const auto it = std::find(ids.begin(), ids.end(), now_ids[i]);
+      if (it == ids.end()) continue;
+      const size_t k = static_cast<size_t>(it - ids.begin());
+      // Agent ids are expand_agents' indices.
+      const float walk = agents->desired_speeds_m_s[now_ids[i]] * kStep;
+      worst = std::max(worst, glm::length(now[i] - prev[k]) / walk);
+    }
+    prev = std::move(now);
+    ids = std::move(now_ids);
+  }
+  return worst;
+}
+
+TEST(DetourCrowd, NoAgentIsPushedFasterThanItCanBeMoved) {
+  const float uncapped = largest_step_over_walk(0.0f);
+  EXPECT_GT(uncapped, 4.0f) << "the jam no longer pushes agents hard: this test shows nothing";
+  const float capped = largest_step_over_walk(DetourParams{}.max_step_speed_factor);
+  std::cout << "largest step over the walking step: " << uncapped << " uncapped, " << capped
+            << " capped\n";
+  EXPECT_LE(capped, DetourParams{}.max_step_speed_factor + 0.01f);
+}
+
 }  // namespace
 }  // namespace gk
