@@ -13,7 +13,11 @@
 namespace gk {
 
 Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& params, size_t capacity)
-    : library_(library), params_(params), capacity_(capacity), ids_(capacity) {
+    : library_(library),
+      params_(params),
+      capacity_(capacity),
+      ids_(capacity),
+      library_doubtful_(gait_analysis_doubtful(library)) {
   set_params(params);
   const size_t nc = library.clips.size();
   const size_t L = capacity * kMaxBlendLayers;
@@ -81,7 +85,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
 
 void Mediator::set_params(const MediatorParams& p) {
   params_ = p;
-  degraded_ = p.mode == MediatorMode::kApm && gait_analysis_doubtful(library_);
+  degraded_ = p.mode == MediatorMode::kApm && library_doubtful_;
   if (degraded_) params_.mode = MediatorMode::kNaive;
 }
 

@@ -114,7 +114,8 @@ class Mediator {
   // Per slot, carried from frame to frame.
   std::vector<glm::vec2> vel_, vel_rate_;  // velocity spring
   std::vector<float> theta_, theta_rate_;  // theta spring (unwrapped)
-  bool degraded_ = false;  // apm asked, naive played (a doubtful library)
+  bool library_doubtful_ = false;  // gait_analysis_doubtful(library_), found once
+  bool degraded_ = false;          // apm asked, naive played (a doubtful library)
   std::vector<float> fed_speed_;           // the speed the simulator was last given [m/s]
   std::vector<float> lower_target_;        // target facing of the lower body
   std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
