@@ -277,6 +277,21 @@ TEST(LocalToModelJob, SubtreeUpdateAfterOneJointChangedEqualsFullPass) {
   }
 }
 
+// A two-bone IK job on the first three model matrices of a chain (hip, knee, ankle), writing its
+// corrections to c0 and c1.
+TwoBoneIKJob chain_ik(const std::vector<glm::mat4>& m, const glm::vec3& target,
+                      const glm::vec3& pole, glm::quat* c0, glm::quat* c1) {
+  TwoBoneIKJob ik;
+  ik.start_model = m[0];
+  ik.mid_model = m[1];
+  ik.end_model = m[2];
+  ik.target = target;
+  ik.pole = pole;
+  ik.out_start_correction = c0;
+  ik.out_mid_correction = c1;
+  return ik;
+}
+
 TEST(TwoBoneIKJob, ReachesRandomTargetsWithKneeTowardPole) {
   const Skeleton s = make_chain(3, 0.45f);
   std::mt19937 rng(7);
@@ -296,14 +311,7 @@ TEST(TwoBoneIKJob, ReachesRandomTargetsWithKneeTowardPole) {
     const glm::vec3 pole(0, 0, 1);
     glm::quat c0, c1;
     bool ok = false;
-    TwoBoneIKJob ik;
-    ik.start_model = m[0];
-    ik.mid_model = m[1];
-    ik.end_model = m[2];
-    ik.target = target;
-    ik.pole = pole;
-    ik.out_start_correction = &c0;
-    ik.out_mid_correction = &c1;
+    TwoBoneIKJob ik = chain_ik(m, target, pole, &c0, &c1);
     ik.out_reached = &ok;
     ASSERT_TRUE(ik.validate());
     ik.run();
@@ -340,15 +348,7 @@ TEST(TwoBoneIKJob, NearlyStraightLimbBendsTowardThePole) {
     const glm::vec3 target = hip + glm::normalize(translation_of(m[2]) - hip) * 0.7f;
     const glm::vec3 pole(0, 0, 1);
     glm::quat c0, c1;
-    TwoBoneIKJob ik;
-    ik.start_model = m[0];
-    ik.mid_model = m[1];
-    ik.end_model = m[2];
-    ik.target = target;
-    ik.pole = pole;
-    ik.out_start_correction = &c0;
-    ik.out_mid_correction = &c1;
-    ik.run();
+    chain_ik(m, target, pole, &c0, &c1).run();
     r[0] = r[0] * c0;
     r[1] = r[1] * c1;
     fk.run();

@@ -61,12 +61,14 @@ inline Result<LocomotionLibrary> load_data_library(std::initializer_list<const c
   return build_locomotion_library(*sets);
 }
 
-// A headless pipeline that records the metrics (no palettes: nothing is drawn).
-inline PipelineOptions test_pipeline_options(size_t capacity, float frame_time_s) {
+// A headless pipeline that records the metrics (by default no palettes: nothing is drawn).
+inline PipelineOptions test_pipeline_options(size_t capacity, float frame_time_s,
+                                             bool make_palettes = false,
+                                             bool record_metrics = true) {
   PipelineOptions o;
   o.capacity = capacity;
-  o.make_palettes = false;
-  o.record_metrics = true;
+  o.make_palettes = make_palettes;
+  o.record_metrics = record_metrics;
   o.frame_time_s = frame_time_s;
   return o;
 }

@@ -27,12 +27,7 @@ std::vector<test::Script> walkers(int n, float speed) {
 }
 
 PipelineOptions drawn(size_t capacity) {
-  PipelineOptions o;
-  o.capacity = capacity;
-  o.make_palettes = true;
-  o.record_metrics = true;
-  o.frame_time_s = kDt;
-  return o;
+  return test::test_pipeline_options(capacity, kDt, /*make_palettes=*/true);
 }
 
 // A source that repeats an agent id on chosen frames (a simulator's bug the mediator refuses).

@@ -23,12 +23,8 @@ namespace {
 constexpr float kDt = 1.0f / 60.0f;
 
 PipelineOptions options(size_t capacity) {
-  PipelineOptions o;
-  o.capacity = capacity;
-  o.make_palettes = true;
-  o.record_metrics = false;
-  o.frame_time_s = kDt;
-  return o;
+  return test::test_pipeline_options(capacity, kDt, /*make_palettes=*/true,
+                                     /*record_metrics=*/false);
 }
 
 LodParams lod_at(glm::vec2 focus, float d0, float d1, float d2, float hysteresis = 2.0f) {
