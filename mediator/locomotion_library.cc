@@ -359,6 +359,16 @@ float flat_toe_height(const LocomotionClip& lc, const Skeleton& sk) {
 }
 
 // Moves a clip up or down by dy [m] (the root joint's translation), keeping everything else.
+// A doubtful clip is played as captured: no lock is planted or held on contacts that cannot be
+// trusted.
+void drop_doubtful_locks(LocomotionClip* lc) {
+  if (lc->doubts.empty()) return;
+  for (int s = 0; s < 2; ++s) {
+    std::fill(lc->plant[s].begin(), lc->plant[s].end(), uint8_t{0});
+    std::fill(lc->hold[s].begin(), lc->hold[s].end(), uint8_t{0});
+  }
+}
+
 void raise_clip(LocomotionClip* lc, float dy) {
   for (Clip* c : {&lc->clip, &lc->source}) {  // the take as captured stands on the same floor
     for (int f = 0; f < c->num_frames; ++f) {
@@ -865,13 +875,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       return leave_out(lc.clip, "no full gait cycle (the contacts do not make one stride)");
     }
     lc.doubts = gait_doubts(lc);
-    if (!lc.doubts.empty()) {
-      // Played as captured: no lock is planted or held on contacts that cannot be trusted.
-      for (int s = 0; s < 2; ++s) {
-        std::fill(lc.plant[s].begin(), lc.plant[s].end(), uint8_t{0});
-        std::fill(lc.hold[s].begin(), lc.hold[s].end(), uint8_t{0});
-      }
-    }
+    drop_doubtful_locks(&lc);
     lib.clips.push_back(std::move(lc));
   };
   for (const ClipSet& set : sets) {
@@ -1141,6 +1145,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       raise_clip(&c, common - planted[i]);
       if (c.gait) {
         fill_contacts_and_heights(&c, sk);
+        drop_doubtful_locks(&c);  // the refill above set them again
       } else {
         for (int s = 0; s < 2; ++s) {
           c.toe_floor_m[s] += common - planted[i];

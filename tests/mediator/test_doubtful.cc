@@ -87,6 +87,32 @@ TEST(DoubtfulClips, AHopIsReportedAndPlayedWithoutFootLocks) {
   }
 }
 
+// Every clip is moved onto the library's one floor at load, and its contacts are then found
+// again: a doubtful clip that stood higher or lower than the others must still plant no lock.
+TEST(DoubtfulClips, ADoubtfulClipMovedOntoTheFloorStillPlantsNoLock) {
+  std::vector<ClipSet> sets{hopping_set()};
+  for (size_t i = 0; i < sets[0].clips.size(); ++i) {
+    Clip& c = sets[0].clips[i];
+    // Each clip captured a different height above the others' floor: 0, 2, 4, ... cm.
+    for (int f = 0; f < c.num_frames; ++f) {
+      c.translations[static_cast<size_t>(f) * c.num_joints].y += 0.02f * static_cast<float>(i);
+    }
+  }
+  auto lib = build_locomotion_library(sets);
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  int gait = 0;
+  for (const LocomotionClip& c : lib->clips) {
+    if (!c.gait) continue;
+    ++gait;
+    ASSERT_FALSE(c.doubts.empty()) << c.clip.name;
+    for (int s = 0; s < 2; ++s) {
+      EXPECT_EQ(std::count(c.plant[s].begin(), c.plant[s].end(), 1), 0) << c.clip.name;
+      EXPECT_EQ(std::count(c.hold[s].begin(), c.hold[s].end(), 1), 0) << c.clip.name;
+    }
+  }
+  EXPECT_GT(gait, 1);
+}
+
 TEST(DoubtfulClips, SteadyCyclesOfTheSharedDataAreSound) {
   GK_REQUIRE_DATA("clips/bvh/more");
   const LocomotionLibrary& builtin = test::builtin_library();
