@@ -220,14 +220,45 @@ std::vector<float> gait_phase(const ClipAnalysis& a, float period_s, bool loops)
   return phase;
 }
 
-// Frames on either side for velocities: about 1/60 s, so 120 fps capture jitter is averaged the
-// same as 30 fps.
-int velocity_half_window(float fps) {
-  return std::max(1, static_cast<int>(std::lround(fps / 60.0f)));
+// Inside a contact, a joint slower than this times the still speed is still planted (jitter).
+constexpr float kContactHysteresis = 1.5f;
+
+// The capture's own position jitter [m, per axis and frame], from the feet's horizontal second
+// differences: a planted foot has none in a clean capture and most frames of a gait plant one
+// of the two feet, so their median is jitter (a 2-D second difference of white noise of sigma
+// per axis has a median length of 1.1774 * sqrt(6) sigma).
+float capture_jitter_m(const Tracks& tr) {
+  std::vector<float> d2;
+  for (int s = 0; s < 2; ++s) {
+    for (const std::vector<glm::vec3>* p : {&tr.toe[s], &tr.ankle[s]}) {
+      for (size_t f = 1; f + 1 < p->size(); ++f) {
+        const glm::vec3 d = (*p)[f + 1] - 2.0f * (*p)[f] + (*p)[f - 1];
+        d2.push_back(std::hypot(d.x, d.z));
+      }
+    }
+  }
+  return d2.empty() ? 0.0f : percentile(d2, 0.5f) / (1.1774f * std::sqrt(6.0f));
 }
 
-// Horizontal velocity of track p at frame f relative to the clip's hips (in_place) or the world,
-// by a central difference over +-k frames (wrapping a loop, whose root jumps back by per_loop).
+// Frames on either side for velocities: about 1/60 s (one frame up to 90 fps), longer where the
+// capture's jitter would make a still foot's speed reach `still_m_s` (noise at most a third of
+// it: a least-squares slope over k + 1 frames has a noise of jitter * fps / sqrt(k (k+1) (k+2) /
+// 12)), up to 1/15 s. A clean capture keeps its contact edges to the frame; a jittery one at a
+// high frame rate averages as many frames as its jitter needs.
+int velocity_half_window(float fps, float jitter_m, float still_m_s) {
+  const int k0 = std::max(1, static_cast<int>(std::lround(fps / 60.0f)));
+  const int k_max = std::max(k0, static_cast<int>(std::lround(fps / 15.0f)));
+  for (int k = k0; k < k_max; ++k) {
+    const float sum_sq = static_cast<float>(k * (k + 1) * (k + 2)) / 12.0f;
+    if (3.0f * jitter_m * fps / std::sqrt(sum_sq) <= still_m_s) return k;
+  }
+  return k_max;
+}
+
+// Horizontal velocity of track p at frame f relative to the clip's hips (in_place) or the world:
+// the least-squares slope over frames f - back .. f + fwd (+-k by default; wrapping a loop, whose
+// root jumps back by per_loop). Over two frames that is their difference; over more it averages
+// every frame's jitter rather than the two ends' alone.
 glm::vec3 track_velocity(const std::vector<glm::vec3>& p, const Tracks& tr, int f, int k,
                          const Clip& clip, bool relative_to_root, int back = -1, int fwd = -1) {
   if (back < 0) back = k;
@@ -250,7 +281,15 @@ glm::vec3 track_velocity(const std::vector<glm::vec3>& p, const Tracks& tr, int 
   const int lo = clip.loops ? f - back : std::max(0, f - back);
   const int hi = clip.loops ? f + fwd : std::min(n - 1, f + fwd);
   if (hi == lo) return glm::vec3(0.0f);
-  glm::vec3 v = (at(hi) - at(lo)) * (clip.fps / static_cast<float>(hi - lo));
+  const float mid = 0.5f * static_cast<float>(lo + hi);
+  glm::vec3 num(0.0f);
+  float den = 0.0f;
+  for (int i = lo; i <= hi; ++i) {
+    const float t = static_cast<float>(i) - mid;
+    num += t * at(i);
+    den += t * t;
+  }
+  glm::vec3 v = num * (clip.fps / den);
   v.y = 0.0f;
   return v;
 }
@@ -260,7 +299,7 @@ glm::vec3 track_velocity(const std::vector<glm::vec3>& p, const Tracks& tr, int 
 // foot's velocity (relative to the hips) is minus the travel velocity.
 glm::vec3 in_place_travel(const Tracks& tr, const Clip& clip) {
   const int n = static_cast<int>(tr.root.size());
-  const int k = velocity_half_window(clip.fps);
+  const int k = velocity_half_window(clip.fps, 0.0f, 0.0f);  // a median: jitter averages out
   std::vector<float> vx, vz;
   // "Lower" against each foot's own lowest heights (a rig's two toe joints need not be level).
   float low[2];
@@ -305,9 +344,9 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
                      const glm::vec3& travel_vel, const ContactThresholds& th,
                      const std::vector<float>* floor, std::vector<uint8_t>* out) {
   const int n = static_cast<int>(tr.root.size());
-  const int k = velocity_half_window(clip.fps);
   const float still =
       std::max(th.min_still_speed_m_s, th.still_fraction_of_travel * glm::length(travel_vel));
+  const int k = velocity_half_window(clip.fps, capture_jitter_m(tr), still);
   out->assign(n, 0);
   const std::vector<glm::vec3>* joints[4] = {&tr.toe[s], &tr.ankle[s], &tr.heel[s], &tr.tip[s]};
   std::vector<uint8_t> down[4];
@@ -335,8 +374,24 @@ void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalys
     }
     const float low = percentile(h, 0.05f), high = percentile(h, 0.95f);
     const float gate = low + std::max(th.min_height_gate_m, th.height_gate_fraction * (high - low));
-    down[j].assign(n, 0);
-    for (int f = 0; f < n; ++f) down[j][f] = (speed[f] < still || backward[f]) && h[f] <= gate;
+    // A run of frames that only jitter put above `still` (slower than kContactHysteresis times
+    // it, and low) between two down frames is down too: a planted foot's jitter does not break
+    // its contact in two. The contact's ends stay where they are.
+    std::vector<uint8_t>& d = down[j];
+    d.assign(n, 0);
+    std::vector<uint8_t> weak(n, 0);
+    for (int f = 0; f < n; ++f) {
+      const bool low = h[f] <= gate;
+      d[f] = low && (speed[f] < still || backward[f]);
+      weak[f] = low && speed[f] < kContactHysteresis * still;
+    }
+    for (int f = 1; f < n; ++f) {
+      if (d[f] || !d[f - 1]) continue;
+      int e = f;
+      while (e < n && !d[e] && weak[e]) ++e;
+      if (e < n && d[e]) std::fill(d.begin() + f, d.begin() + e, uint8_t{1});
+      f = e;
+    }
   }
   for (int f = 0; f < n; ++f) (*out)[f] = down[0][f] || down[1][f] || down[2][f] || down[3][f];
 }

@@ -216,8 +216,9 @@ void expect_same(const ClipAnalysis& want, const ClipAnalysis& got, const Tolera
       }
     }
   }
+  // One frame (and a hair: two times that differ by exactly one frame are not exact in float).
   const float cw = want.cycle.end_s - want.cycle.start_s, cg = got.cycle.end_s - got.cycle.start_s;
-  EXPECT_NEAR(cg, cw, std::max(tol.cycle * cw, 1.0f / std::min(want.fps, got.fps)))
+  EXPECT_NEAR(cg, cw, std::max(tol.cycle * cw, 1.01f / std::min(want.fps, got.fps)))
       << what << ": cycle";
 }
 
@@ -407,7 +408,9 @@ void expect_jitter_invariance(const Case& c) {
     Rig t = r;
     t.clip = jittered(r.clip, seed, 2.0f, 0.5f);
     Tolerance tol;
-    tol.contact_s = 2.01f / r.clip.fps;
+    // Two frames, and at a high frame rate two frames at 30 fps, as the hand labels: velocities
+    // are taken over 1/30 s at any rate, so an edge moved by jitter is found within that span.
+    tol.contact_s = std::max(2.01f / r.clip.fps, 2.01f / 30.0f);
     const std::string what = std::string(c.file) + " jittered, seed " + std::to_string(seed);
     const ClipAnalysis a = analyze(t);
     expect_same(base, a, tol, what);
@@ -422,10 +425,6 @@ TEST(Invariance, CaptureJitter) {
 }
 
 TEST(Invariance, CaptureJitterTurnAnd120Fps) {
-  GTEST_SKIP() << "known failure: at 120 fps the same per-frame jitter (about 1 cm at the toe, "
-                  "white) makes the toe's speed over 1/60 s noisier than the still threshold and "
-                  "no contact survives; on the 30 fps turn a contact cut by the first frame breaks "
-                  "in two and one lift-off moves by 3 frames.";
   expect_jitter_invariance(kTakes[1]);
   expect_jitter_invariance(kTakes[3]);
 }
