@@ -420,6 +420,27 @@ void SkinningPaletteJob::run() const {
   }
 }
 
+float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b) {
+  const size_t n = std::min(a.size(), b.size());
+  float d_min = 1.0f;
+  size_t j = 0;
+#if defined(__SSE2__)
+  if (n >= 4) {
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 m = _mm_set1_ps(1.0f);
+    for (; j + 4 <= n; j += 4) {
+      // min(x, m) keeps m where x is NaN, as std::min(m, x) does.
+      m = _mm_min_ps(_mm_and_ps(dot4(load4(a.data() + j), load4(b.data() + j)), abs_mask), m);
+    }
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, m);
+    d_min = std::min(std::min(lanes[0], lanes[1]), std::min(lanes[2], lanes[3]));
+  }
+#endif
+  for (; j < n; ++j) d_min = std::min(d_min, std::abs(glm::dot(a[j], b[j])));
+  return d_min;
+}
+
 bool is_affine(std::span<const glm::mat4> matrices) {
   for (const glm::mat4& m : matrices) {
     if (m[0][3] != 0.0f || m[1][3] != 0.0f || m[2][3] != 0.0f || m[3][3] != 1.0f) return false;

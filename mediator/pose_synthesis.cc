@@ -14,6 +14,9 @@ namespace gk {
 struct PoseSynthesizer::Scratch {
   std::vector<glm::quat> rot;    // 2 * kMaxBlendLayers * joints (a layer and its seam sample)
   std::vector<glm::vec3> trans;  // 2 * kMaxBlendLayers * joints
+  // The slot's local rotations of its last frame (local_rot_ before this frame overwrites it):
+  // the pop metric's rotation change compares against them, with no per-slot copy kept.
+  std::vector<glm::quat> prev_rot;  // joints
 };
 
 namespace {
@@ -114,7 +117,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   }
   local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
   local_trans_.assign(capacity * J, glm::vec3(0.0f));
-  prev_local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
   world_.assign(capacity * J, glm::mat4(1.0f));
   if (make_palettes_) palette_.assign(capacity * J, glm::mat4(1.0f));
   rot_change_.assign(capacity, 0.0f);
@@ -135,6 +137,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     Scratch s;
     s.rot.resize(2 * kMaxBlendLayers * J);
     s.trans.resize(2 * kMaxBlendLayers * J);
+    s.prev_rot.resize(J);
     return s;
   });
   subtree_end_ = subtree_ends(skeleton_);
@@ -275,7 +278,6 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
   prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
   prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
-  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
 
   // Sample and blend the planned layers.
   PoseLayer layers[2 * kMaxBlendLayers];
@@ -306,6 +308,8 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     }
   }
   std::span<glm::quat> out_r(local_rot_.data() + base, J);
+  // The slot's local rotations still are its last frame's (a held slot keeps them).
+  if (has_prev_[slot]) std::copy_n(out_r.begin(), J, s.prev_rot.begin());
   std::span<glm::vec3> out_t(local_trans_.data() + base, J);
   BlendPosesJob{{layers, static_cast<size_t>(num_layers)}, out_r, out_t}.run();
 
@@ -338,11 +342,9 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   float change = 0.0f;
   if (has_prev_[slot] && J > 1) {
     // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
-    float d_min = 1.0f;
-    for (size_t j = 1; j < J; ++j) {  // joint 0 carries the root facing, not a local bend
-      d_min = std::min(d_min, std::abs(glm::dot(local_rot_[base + j], prev_local_rot_[base + j])));
-    }
-    change = 2.0f * std::acos(d_min);
+    // Joint 0 carries the root facing, not a local bend.
+    change = 2.0f * std::acos(min_abs_dot({local_rot_.data() + base + 1, J - 1},
+                                          {s.prev_rot.data() + 1, J - 1}));
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -361,7 +363,6 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
     }
   }
-  std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   has_prev_[slot] = 1;
   if (make_palettes_) {
     SkinningPaletteJob job;
@@ -466,7 +467,9 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   glm::mat4 placed = root;
   placed[3].y -= drop;
   // Lowering the root lowers every joint by the same amount: no need for a second FK pass.
-  for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
+  if (drop != 0.0f) {
+    for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
+  }
 
   glm::quat ankle_world_rot[2];
   bool use_ik[2] = {false, false};
@@ -486,7 +489,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     use_ik[side] = glm::dot(toe_offset[side], toe_offset[side]) > 1e-10f ||
                    drawn_ankle.y + toe_offset[side].y < library_.planted_ankle_m[side] ||
                    locks_.heel_pitch[static_cast<size_t>(slot) * 2 + side] > 0.0f;
-    ankle_world_rot[side] = rotation_of(world_[base + ankle]);
+    if (use_ik[side]) ankle_world_rot[side] = rotation_of(world_[base + ankle]);
   }
   if (!use_ik[0] && !use_ik[1]) return;
   for (int side = 0; side < 2; ++side) {
@@ -572,8 +575,10 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   }
   fk_ranges(slot, use_ik[0] ? leg_above_ankle_[0] : JointRange{},
             use_ik[1] ? leg_above_ankle_[1] : JointRange{}, placed);
-  // Restore each ankle's world orientation under its new shin, then finish the feet.
+  // Restore each ankle's world orientation under its new shin, then finish the feet. A leg
+  // without IK keeps its shin, ankle and foot as posed.
   for (int side = 0; side < 2; ++side) {
+    if (!use_ik[side]) continue;
     const Side sd = static_cast<Side>(side);
     const int ankle = skeleton_.ankle(sd);
     const int parent = skeleton_.parents[ankle];
@@ -581,8 +586,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
     local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
   }
-  fk_ranges(slot, subtree(skeleton_.ankle(Side::kLeft)), subtree(skeleton_.ankle(Side::kRight)),
-            placed);
+  fk_ranges(slot, use_ik[0] ? subtree(skeleton_.ankle(Side::kLeft)) : JointRange{},
+            use_ik[1] ? subtree(skeleton_.ankle(Side::kRight)) : JointRange{}, placed);
 }
 
 }  // namespace gk

@@ -103,7 +103,6 @@ class PoseSynthesizer {
   std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::quat> local_rot_;
   std::vector<glm::vec3> local_trans_;
-  std::vector<glm::quat> prev_local_rot_;
   std::vector<glm::mat4> world_;
   std::vector<glm::mat4> palette_;
   std::vector<float> rot_change_;
