@@ -109,6 +109,49 @@ glm::quat rotation_between(glm::vec3 from, glm::vec3 to) {
   return glm::angleAxis(std::atan2(axis_len, d), axis / axis_len);
 }
 
+// Rotation by the angle whose cosine and sine are proportional to (c, s) (atan2(s, c), any common
+// positive scale) about the unit axis, without the angle: the half-angle quaternion is
+// proportional to (1 + cos, sin axis) = (r + c, s axis) / r. Exact in value; near half a turn
+// (r + c small against r) that cancels, so the angle is taken there.
+glm::quat rotation_of_cos_sin(float c, float s, const glm::vec3& axis) {
+  const float r = std::sqrt(c * c + s * s);
+  if (!(r > 0.0f)) return glm::quat(1, 0, 0, 0);
+  if (r + c < 1e-3f * r) return glm::angleAxis(std::atan2(s, c), axis);
+  return glm::normalize(glm::quat(r + c, s * axis.x, s * axis.y, s * axis.z));
+}
+
+// cos and sin of half of acos(c) for c in [-1, 1] (both >= 0: the angle is in [0, pi]).
+struct HalfAngle {
+  float cos, sin;
+};
+HalfAngle half_of_acos(float c) {
+  return {std::sqrt(std::max(0.0f, 0.5f * (1.0f + c))),
+          std::sqrt(std::max(0.0f, 0.5f * (1.0f - c)))};
+}
+
+// Rotation by acos(c1) - acos(c0) about the unit axis: the half angles' difference by the
+// angle-difference identities (no acos, no sin or cos).
+glm::quat rotation_by_acos_difference(float c1, float c0, const glm::vec3& axis) {
+  const HalfAngle h1 = half_of_acos(c1), h0 = half_of_acos(c0);
+  const float cw = h1.cos * h0.cos + h1.sin * h0.sin;
+  const float sw = h1.sin * h0.cos - h1.cos * h0.sin;
+  return glm::quat(cw, sw * axis.x, sw * axis.y, sw * axis.z);
+}
+
+// rotation_between without the angle: the half-way quaternion (1 + cos, from x to), normalised,
+// is the same rotation (see rotation_of_cos_sin).
+glm::quat rotation_between_fast(glm::vec3 from, glm::vec3 to) {
+  const float lf = glm::length(from), lt = glm::length(to);
+  if (lf < 1e-8f || lt < 1e-8f) return glm::quat(1, 0, 0, 0);
+  from /= lf;
+  to /= lt;
+  const float d = clamp_unit(glm::dot(from, to));
+  const glm::vec3 axis = glm::cross(from, to);
+  const float axis_len = glm::length(axis);
+  if (axis_len < 1e-7f || d < -0.999f) return rotation_between(from, to);
+  return rotation_of_cos_sin(d, axis_len, axis / axis_len);
+}
+
 }  // namespace
 
 float heading_of(const glm::vec3& dir) { return std::atan2(dir.x, dir.z); }
@@ -318,16 +361,15 @@ void TwoBoneIKJob::run() const {
   const float lat = std::clamp(soft_reach, min_len, std::max(min_len, max_len));
   if (out_reached) *out_reached = reach <= max_len && reach >= min_len;
 
-  // Current and desired interior angles.
+  // Current and desired interior angles, by their cosines (the rotations by their differences
+  // need no angle: rotation_by_acos_difference).
   const glm::vec3 ab = glm::normalize(b - a), bc = glm::normalize(c - b);
   if (lac < 1e-6f) return;
   const glm::vec3 ac_n = ac / lac;
-  const float ac_ab_0 = std::acos(clamp_unit(glm::dot(ac_n, ab)));
-  const float ba_bc_0 = std::acos(clamp_unit(glm::dot(-ab, bc)));
-  const float ac_ab_1 =
-      std::acos(clamp_unit((lcb * lcb - lab * lab - lat * lat) / (-2.0f * lab * lat)));
-  const float ba_bc_1 =
-      std::acos(clamp_unit((lat * lat - lab * lab - lcb * lcb) / (-2.0f * lab * lcb)));
+  const float cos_hip_0 = clamp_unit(glm::dot(ac_n, ab));
+  const float cos_knee_0 = clamp_unit(glm::dot(-ab, bc));
+  const float cos_hip_1 = clamp_unit((lcb * lcb - lab * lab - lat * lat) / (-2.0f * lab * lat));
+  const float cos_knee_1 = clamp_unit((lat * lat - lab * lab - lcb * lcb) / (-2.0f * lab * lcb));
 
   // Bend plane normal: the current plane of the limb, or the pole plane when the limb is straight
   // or within 2 deg of it (its own plane may then point either way from frame to frame, and the
@@ -335,24 +377,31 @@ void TwoBoneIKJob::run() const {
   // In the pole's plane the limb's present bend counts by its share along that plane's normal
   // (negative when it bends away from the pole): continuous as the limb straightens.
   glm::vec3 axis0 = glm::cross(ac_n, ab);
-  float hip_0 = ac_ab_0, knee_0 = ba_bc_0;
   const float own = glm::length(axis0);
   const glm::vec3 pole_axis = glm::cross(ac_n, pole);
-  if (own < kStraightLimb && glm::length(pole_axis) >= 1e-5f) {
+  const bool in_pole_plane = own < kStraightLimb && glm::length(pole_axis) >= 1e-5f;
+  float along = 0.0f;
+  if (in_pole_plane) {
     const glm::vec3 n = glm::normalize(pole_axis);
-    const float along = own > 1e-9f ? glm::dot(axis0 / own, n) : 0.0f;
-    hip_0 = along * ac_ab_0;
-    knee_0 = kPi - along * (kPi - ba_bc_0);
+    along = own > 1e-9f ? glm::dot(axis0 / own, n) : 0.0f;
     axis0 = n;
   }
   if (glm::length(axis0) < 1e-5f) axis0 = glm::cross(ac_n, glm::vec3(1, 0, 0));
   axis0 = glm::normalize(axis0);
 
-  const glm::quat r_bend = glm::angleAxis(ac_ab_1 - hip_0, axis0);
-  const glm::quat r_knee = glm::angleAxis(ba_bc_1 - knee_0, axis0);
+  glm::quat r_bend, r_knee;
+  if (in_pole_plane) {  // the present bend scaled by its share: the angles themselves
+    const float hip_0 = along * std::acos(cos_hip_0);
+    const float knee_0 = kPi - along * (kPi - std::acos(cos_knee_0));
+    r_bend = glm::angleAxis(std::acos(cos_hip_1) - hip_0, axis0);
+    r_knee = glm::angleAxis(std::acos(cos_knee_1) - knee_0, axis0);
+  } else {
+    r_bend = rotation_by_acos_difference(cos_hip_1, cos_hip_0, axis0);
+    r_knee = rotation_by_acos_difference(cos_knee_1, cos_knee_0, axis0);
+  }
   // End joint after the bend, then swing the chain onto the target direction.
   const glm::vec3 c1 = a + r_bend * (b - a) + r_bend * (r_knee * (c - b));
-  const glm::quat r_swing = rotation_between(c1 - a, target - a);
+  const glm::quat r_swing = rotation_between_fast(c1 - a, target - a);
   glm::quat r = r_swing * r_bend;
 
   // Twist about the start-target axis so the knee points toward the pole.
@@ -361,9 +410,9 @@ void TwoBoneIKJob::run() const {
   const glm::vec3 knee_p = knee - axis_t * glm::dot(knee, axis_t);
   const glm::vec3 pole_p = pole - axis_t * glm::dot(pole, axis_t);
   if (glm::length(knee_p) > 1e-5f && glm::length(pole_p) > 1e-5f) {
-    const float twist =
-        std::atan2(glm::dot(glm::cross(knee_p, pole_p), axis_t), glm::dot(knee_p, pole_p));
-    r = glm::angleAxis(twist, axis_t) * r;
+    r = rotation_of_cos_sin(glm::dot(knee_p, pole_p), glm::dot(glm::cross(knee_p, pole_p), axis_t),
+                            axis_t) *
+        r;
   }
 
   const glm::quat qa = glm::quat_cast(glm::mat3(start_model));
