@@ -187,8 +187,11 @@ void SampleClipJob::run() const {
   int i0, i1;
   float t;
   if (clip->loops) {
-    f = std::fmod(f, static_cast<float>(frames));
-    if (f < 0.0f) f += frames;
+    // fmod returns an f already in [0, frames) as it is: skip the call (same bits).
+    if (!(f >= 0.0f && f < static_cast<float>(frames))) {
+      f = std::fmod(f, static_cast<float>(frames));
+      if (f < 0.0f) f += frames;
+    }
     i0 = std::min(static_cast<int>(f), frames - 1);
     i1 = (i0 + 1) % frames;
     t = f - i0;

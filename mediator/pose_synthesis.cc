@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -43,6 +44,12 @@ constexpr float kMaxHeelOff = 1.0f;
 // knee's position changes ever faster with the foot's distance, and a hard clamp snaps it.
 constexpr float kIkMaxExtension = 0.999f;
 constexpr float kIkSoften = 0.98f;
+
+// critical_spring, skipped (its exp too) when it is at rest on a goal of 0: it would stay there.
+void settle_spring(float& x, float& v, float goal, float halflife_s, float dt) {
+  if (x == 0.0f && v == 0.0f && goal == 0.0f) return;
+  critical_spring(x, v, goal, halflife_s, dt);
+}
 
 // How much more the foot may pitch up from its elevation (toe -> ankle vector d) [rad].
 float heel_room(const glm::vec3& d) {
@@ -177,6 +184,14 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   // A crowd's palettes far larger than the caches are written past them (read only by the
   // upload, after the whole crowd is posed); a small crowd's stay cached for it.
   stream_palettes_ = palette_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
+  if (can_twist_) {
+    auto outside = [&](JointRange r) { return hips < r.from || hips >= r.to; };
+    hips_kept_ = outside(twist_range_);
+    for (int side = 0; side < 2; ++side) {
+      hips_kept_ = hips_kept_ && outside(leg_above_ankle_[side]) &&
+                   outside(subtree(skeleton_.ankle(static_cast<Side>(side))));
+    }
+  }
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -327,15 +342,19 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   } else {
     fk(slot, 0, num_joints_, root);
   }
+  float pelvis_read = std::numeric_limits<float>::quiet_NaN();
   if (twisting) {
-    twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
+    pelvis_read = twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
   if (locking) lock_feet(pl, P, slot, root, dt);
 
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
-    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+    // The twist read the pelvis heading, and what it and leg IK re-posed left the hips alone.
+    pelvis_heading_[slot] = hips_kept_ && !std::isnan(pelvis_read)
+                                ? pelvis_read
+                                : joint_heading(world_[base + hips], rest_forward_[hips]);
     upper_heading_[slot] = joint_heading(world_[base + chest], rest_forward_[chest]);
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
@@ -375,10 +394,10 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   }
 }
 
-void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {
+float PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {
   const std::vector<int16_t>& chain = skeleton_.spine_chain;
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
-  if (chain.empty() || hips < 0 || chest < 0) return;
+  if (chain.empty() || hips < 0 || chest < 0) return std::numeric_limits<float>::quiet_NaN();
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const float pelvis = joint_heading(world_[base + hips], rest_forward_[hips]);
   const float chest_now = joint_heading(world_[base + chest], rest_forward_[chest]);
@@ -402,6 +421,7 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
     local_rot_[base + j] = glm::normalize(local_rot_[base + j] * corr);
   }
   fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
+  return pelvis;
 }
 
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
@@ -461,7 +481,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     if (dx < reach && dy > 0.0f) needed = std::max(needed, dy - std::sqrt(reach * reach - dx * dx));
   }
   if (pl.fresh[slot]) drop_[slot] = drop_rate_[slot] = 0.0f;
-  critical_spring(drop_[slot], drop_rate_[slot], std::min(needed, kMaxDrop), kDropHalflife, dt);
+  settle_spring(drop_[slot], drop_rate_[slot], std::min(needed, kMaxDrop), kDropHalflife, dt);
   drop_[slot] = std::clamp(drop_[slot], 0.0f, kMaxDrop);
   const float drop = drop_[slot];
   glm::mat4 placed = root;
@@ -529,7 +549,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     }
     // Up fast (a heel that must rise cannot wait long), down slowly; both on springs, so the
     // ankle never turns by more in a frame than a clip's joints do.
-    critical_spring(pitch, pitch_rate, reach_pitch,
+    settle_spring(pitch, pitch_rate, reach_pitch,
                     reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
     // Above the floor it must be at once (a heel below the floor is seen).
     pitch = std::max(pitch, floor_pitch);

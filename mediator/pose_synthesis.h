@@ -91,7 +91,8 @@ class PoseSynthesizer {
   JointRange subtree(int joint) const;
   // Forward kinematics of two ranges (overlapping ones in one pass).
   void fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root);
-  void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
+  // Returns the pelvis heading it read [rad] (NaN when it did not twist).
+  float twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
   void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
                  float dt);
 
@@ -128,6 +129,8 @@ class PoseSynthesizer {
   std::vector<int16_t> pre_twist_joints_;
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
+  // Neither the twist nor leg IK re-poses the hips joint: its heading read by the twist stands.
+  bool hips_kept_ = false;
 };
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
