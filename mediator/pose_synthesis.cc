@@ -39,6 +39,7 @@ constexpr float kDropHalflife = 0.05f;  // [s]
 // A raised heel puts the toe -> ankle line at most this steep [rad] (about 57 deg, a stance
 // foot's plantarflexion at toe-off): the pivot never turns a foot past standing on its tip.
 constexpr float kMaxHeelOff = 1.0f;
+constexpr float kPi = 3.14159265358979f;
 
 // Legs straighten smoothly over the last part of their reach (soft IK): near full extension a
 // knee's position changes ever faster with the foot's distance, and a hard clamp snaps it.
@@ -71,11 +72,50 @@ float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle_floor)
   return std::clamp(want - now, 0.0f, heel_room(d));
 }
 
-// The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
-// about the ball, as far as heel_room allows (bisection; the distance shrinks as the heel rises
-// toward the hip). Returns the pitch [rad].
+}  // namespace
+
 float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
                      float limit) {
+  const glm::vec3 d = ankle - toe;
+  const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
+  const float room = heel_room(d);
+  auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
+  if (dist(room) > limit) return room;
+  // Each step asks whether dist(mid) > limit. The axis is square to d, so the squared distance
+  // is K + A cos a + B sin a = K + M cos(a - phi): it exceeds limit^2 where |a - phi| (wrapped)
+  // is below acos((limit^2 - K) / M). Far from that boundary the answer is certain without the
+  // rotation; within kSure of it, and near a tangency where the boundary is ill-conditioned,
+  // the step measures dist as before, so the steps, and the pitch, are the same.
+  constexpr float kSure = 1e-3f;  // [rad], against an analytic error of about 1e-5 rad
+  const glm::vec3 e = toe - hip;
+  const glm::vec3 w = glm::cross(axis, d);
+  const float k = glm::dot(e, e) + glm::dot(d, d);
+  const float a_cos = 2.0f * glm::dot(e, d), b_sin = 2.0f * glm::dot(e, w);
+  const float m = std::sqrt(a_cos * a_cos + b_sin * b_sin);
+  const float c = m > 1e-6f ? (limit * limit - k) / m : 2.0f;
+  const bool analytic = std::abs(c) < 1.0f - 1e-3f;
+  const float phi = analytic ? std::atan2(b_sin, a_cos) : 0.0f;
+  const float half_width = analytic ? std::acos(c) : 0.0f;
+  auto beyond = [&](float a) {
+    if (analytic) {
+      float delta = a - phi;
+      if (delta > kPi) delta -= 2.0f * kPi;
+      if (delta < -kPi) delta += 2.0f * kPi;
+      const float margin = half_width - std::abs(delta);
+      if (std::abs(margin) > kSure) return margin > 0.0f;
+    }
+    return dist(a) > limit;
+  };
+  float lo = 0.0f, hi = room;
+  for (int i = 0; i < 12; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (beyond(mid) ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                               float limit) {
   const glm::vec3 d = ankle - toe;
   const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
   const float room = heel_room(d);
@@ -88,8 +128,6 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
   }
   return hi;
 }
-
-}  // namespace
 
 float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward) {
   // The world matrix's rotation applied to the rest-relative forward (no quaternion needed: the
