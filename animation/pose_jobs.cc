@@ -313,18 +313,48 @@ bool LocalToModelJob::validate() const {
 void LocalToModelJob::run() const {
   const int n = skeleton->num_joints();
   const int end = to < 0 ? n : std::min(to, n);
-  for (int j = std::max(from, 0); j < end; ++j) {
+  // p * [R t; 0 1], leaving out the products with the local matrix's zeros (the sums keep glm's
+  // order, so the result is glm's p * local to the bit). r: the rotation's matrix, column-major.
+  auto compose = [&](int j, const float* r) {
     const int parent = skeleton->parents[j];
     const glm::mat4& p = parent < 0 ? root_transform : out_model[parent];
-    // p * [R t; 0 1], leaving out the products with the local matrix's zeros (the sums keep glm's
-    // order, so the result is glm's p * local to the bit).
-    const glm::mat3 r = glm::mat3_cast(rotations[j]);
     const glm::vec3& t = translations[j];
     glm::mat4& m = out_model[j];
-    m[0] = p[0] * r[0][0] + p[1] * r[0][1] + p[2] * r[0][2];
-    m[1] = p[0] * r[1][0] + p[1] * r[1][1] + p[2] * r[1][2];
-    m[2] = p[0] * r[2][0] + p[1] * r[2][1] + p[2] * r[2][2];
+    m[0] = p[0] * r[0] + p[1] * r[1] + p[2] * r[2];
+    m[1] = p[0] * r[3] + p[1] * r[4] + p[2] * r[5];
+    m[2] = p[0] * r[6] + p[1] * r[7] + p[2] * r[8];
     m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
+  };
+  int j = std::max(from, 0);
+#if defined(__SSE2__)
+  // The rotation matrices of four joints at once (they do not depend on the parents), each lane
+  // glm::mat3_cast's operations in its order: the same bits.
+  for (; j + 4 <= end; j += 4) {
+    const Quat4 q = load4(rotations.data() + j);
+    const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
+    const __m128 xx = _mm_mul_ps(q.x, q.x), yy = _mm_mul_ps(q.y, q.y), zz = _mm_mul_ps(q.z, q.z);
+    const __m128 xz = _mm_mul_ps(q.x, q.z), xy = _mm_mul_ps(q.x, q.y), yz = _mm_mul_ps(q.y, q.z);
+    const __m128 wx = _mm_mul_ps(q.w, q.x), wy = _mm_mul_ps(q.w, q.y), wz = _mm_mul_ps(q.w, q.z);
+    alignas(16) float e[9][4];
+    _mm_store_ps(e[0], _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz))));
+    _mm_store_ps(e[1], _mm_mul_ps(two, _mm_add_ps(xy, wz)));
+    _mm_store_ps(e[2], _mm_mul_ps(two, _mm_sub_ps(xz, wy)));
+    _mm_store_ps(e[3], _mm_mul_ps(two, _mm_sub_ps(xy, wz)));
+    _mm_store_ps(e[4], _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz))));
+    _mm_store_ps(e[5], _mm_mul_ps(two, _mm_add_ps(yz, wx)));
+    _mm_store_ps(e[6], _mm_mul_ps(two, _mm_add_ps(xz, wy)));
+    _mm_store_ps(e[7], _mm_mul_ps(two, _mm_sub_ps(yz, wx)));
+    _mm_store_ps(e[8], _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy))));
+    for (int k = 0; k < 4; ++k) {
+      const float r[9] = {e[0][k], e[1][k], e[2][k], e[3][k], e[4][k],
+                          e[5][k], e[6][k], e[7][k], e[8][k]};
+      compose(j + k, r);
+    }
+  }
+#endif
+  for (; j < end; ++j) {
+    const glm::mat3 r = glm::mat3_cast(rotations[j]);  // three packed columns of three
+    compose(j, &r[0][0]);
   }
 }
 
