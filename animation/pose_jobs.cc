@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -313,48 +314,64 @@ bool LocalToModelJob::validate() const {
 void LocalToModelJob::run() const {
   const int n = skeleton->num_joints();
   const int end = to < 0 ? n : std::min(to, n);
-  // p * [R t; 0 1], leaving out the products with the local matrix's zeros (the sums keep glm's
-  // order, so the result is glm's p * local to the bit). r: the rotation's matrix, column-major.
-  auto compose = [&](int j, const float* r) {
-    const int parent = skeleton->parents[j];
-    const glm::mat4& p = parent < 0 ? root_transform : out_model[parent];
-    const glm::vec3& t = translations[j];
-    glm::mat4& m = out_model[j];
-    m[0] = p[0] * r[0] + p[1] * r[1] + p[2] * r[2];
-    m[1] = p[0] * r[3] + p[1] * r[4] + p[2] * r[5];
-    m[2] = p[0] * r[6] + p[1] * r[7] + p[2] * r[8];
-    m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
-  };
   int j = std::max(from, 0);
 #if defined(__SSE2__)
-  // The rotation matrices of four joints at once (they do not depend on the parents), each lane
-  // glm::mat3_cast's operations in its order: the same bits.
+  // p * [R t; 0 1] as glm's p * local, leaving out the products with the local matrix's zeros
+  // (the sums in glm's order: the same bits). The rotation matrices of four joints at once (they
+  // do not depend on the parents), each lane glm::mat3_cast's operations in its order; each joint
+  // then takes its lane's entries, broadcast, straight from the registers.
+  auto parent_of = [&](int joint) -> const glm::mat4& {
+    const int parent = skeleton->parents[joint];
+    return parent < 0 ? root_transform : out_model[parent];
+  };
+  auto compose = [&](int joint, const __m128* e, auto lane) {
+    constexpr int k = decltype(lane)::value;
+    auto at = [&](int i) { return _mm_shuffle_ps(e[i], e[i], _MM_SHUFFLE(k, k, k, k)); };
+    const glm::mat4& p = parent_of(joint);
+    const __m128 p0 = _mm_loadu_ps(&p[0].x), p1 = _mm_loadu_ps(&p[1].x),
+                 p2 = _mm_loadu_ps(&p[2].x), p3 = _mm_loadu_ps(&p[3].x);
+    auto column = [&](__m128 a, __m128 b, __m128 c) {
+      return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
+    };
+    const glm::vec3& t = translations[joint];
+    float* m = &out_model[joint][0].x;
+    _mm_storeu_ps(m, column(at(0), at(1), at(2)));
+    _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
+    _mm_storeu_ps(m + 8, column(at(6), at(7), at(8)));
+    _mm_storeu_ps(m + 12, _mm_add_ps(column(_mm_set1_ps(t.x), _mm_set1_ps(t.y), _mm_set1_ps(t.z)),
+                                     p3));
+  };
   for (; j + 4 <= end; j += 4) {
     const Quat4 q = load4(rotations.data() + j);
     const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
     const __m128 xx = _mm_mul_ps(q.x, q.x), yy = _mm_mul_ps(q.y, q.y), zz = _mm_mul_ps(q.z, q.z);
     const __m128 xz = _mm_mul_ps(q.x, q.z), xy = _mm_mul_ps(q.x, q.y), yz = _mm_mul_ps(q.y, q.z);
     const __m128 wx = _mm_mul_ps(q.w, q.x), wy = _mm_mul_ps(q.w, q.y), wz = _mm_mul_ps(q.w, q.z);
-    alignas(16) float e[9][4];
-    _mm_store_ps(e[0], _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz))));
-    _mm_store_ps(e[1], _mm_mul_ps(two, _mm_add_ps(xy, wz)));
-    _mm_store_ps(e[2], _mm_mul_ps(two, _mm_sub_ps(xz, wy)));
-    _mm_store_ps(e[3], _mm_mul_ps(two, _mm_sub_ps(xy, wz)));
-    _mm_store_ps(e[4], _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz))));
-    _mm_store_ps(e[5], _mm_mul_ps(two, _mm_add_ps(yz, wx)));
-    _mm_store_ps(e[6], _mm_mul_ps(two, _mm_add_ps(xz, wy)));
-    _mm_store_ps(e[7], _mm_mul_ps(two, _mm_sub_ps(yz, wx)));
-    _mm_store_ps(e[8], _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy))));
-    for (int k = 0; k < 4; ++k) {
-      const float r[9] = {e[0][k], e[1][k], e[2][k], e[3][k], e[4][k],
-                          e[5][k], e[6][k], e[7][k], e[8][k]};
-      compose(j + k, r);
-    }
+    const __m128 e[9] = {_mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz))),
+                         _mm_mul_ps(two, _mm_add_ps(xy, wz)),
+                         _mm_mul_ps(two, _mm_sub_ps(xz, wy)),
+                         _mm_mul_ps(two, _mm_sub_ps(xy, wz)),
+                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz))),
+                         _mm_mul_ps(two, _mm_add_ps(yz, wx)),
+                         _mm_mul_ps(two, _mm_add_ps(xz, wy)),
+                         _mm_mul_ps(two, _mm_sub_ps(yz, wx)),
+                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)))};
+    compose(j, e, std::integral_constant<int, 0>{});
+    compose(j + 1, e, std::integral_constant<int, 1>{});
+    compose(j + 2, e, std::integral_constant<int, 2>{});
+    compose(j + 3, e, std::integral_constant<int, 3>{});
   }
 #endif
   for (; j < end; ++j) {
-    const glm::mat3 r = glm::mat3_cast(rotations[j]);  // three packed columns of three
-    compose(j, &r[0][0]);
+    const int parent = skeleton->parents[j];
+    const glm::mat4& p = parent < 0 ? root_transform : out_model[parent];
+    const glm::mat3 r = glm::mat3_cast(rotations[j]);
+    const glm::vec3& t = translations[j];
+    glm::mat4& m = out_model[j];
+    m[0] = p[0] * r[0][0] + p[1] * r[0][1] + p[2] * r[0][2];
+    m[1] = p[0] * r[1][0] + p[1] * r[1][1] + p[2] * r[1][2];
+    m[2] = p[0] * r[2][0] + p[1] * r[2][1] + p[2] * r[2][2];
+    m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
   }
 }
 
