@@ -328,8 +328,8 @@ void LocalToModelJob::run() const {
     constexpr int k = decltype(lane)::value;
     auto at = [&](int i) { return _mm_shuffle_ps(e[i], e[i], _MM_SHUFFLE(k, k, k, k)); };
     const glm::mat4& p = parent_of(joint);
-    const __m128 p0 = _mm_loadu_ps(&p[0].x), p1 = _mm_loadu_ps(&p[1].x),
-                 p2 = _mm_loadu_ps(&p[2].x), p3 = _mm_loadu_ps(&p[3].x);
+    const __m128 p0 = _mm_loadu_ps(&p[0].x), p1 = _mm_loadu_ps(&p[1].x), p2 = _mm_loadu_ps(&p[2].x),
+                 p3 = _mm_loadu_ps(&p[3].x);
     auto column = [&](__m128 a, __m128 b, __m128 c) {
       return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
     };
@@ -338,8 +338,8 @@ void LocalToModelJob::run() const {
     _mm_storeu_ps(m, column(at(0), at(1), at(2)));
     _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
     _mm_storeu_ps(m + 8, column(at(6), at(7), at(8)));
-    _mm_storeu_ps(m + 12, _mm_add_ps(column(_mm_set1_ps(t.x), _mm_set1_ps(t.y), _mm_set1_ps(t.z)),
-                                     p3));
+    _mm_storeu_ps(m + 12,
+                  _mm_add_ps(column(_mm_set1_ps(t.x), _mm_set1_ps(t.y), _mm_set1_ps(t.z)), p3));
   };
   for (; j + 4 <= end; j += 4) {
     const Quat4 q = load4(rotations.data() + j);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -15,9 +14,6 @@ namespace gk {
 struct PoseSynthesizer::Scratch {
   std::vector<glm::quat> rot;    // 2 * kMaxBlendLayers * joints (a layer and its seam sample)
   std::vector<glm::vec3> trans;  // 2 * kMaxBlendLayers * joints
-  // The slot's local rotations of its last frame (local_rot_ before this frame overwrites it):
-  // the pop metric's rotation change compares against them, with no per-slot copy kept.
-  std::vector<glm::quat> prev_rot;  // joints
 };
 
 namespace {
@@ -162,6 +158,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   }
   local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
   local_trans_.assign(capacity * J, glm::vec3(0.0f));
+  prev_local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
   world_.assign(capacity * J, glm::mat4(1.0f));
   if (make_palettes_) palette_.assign(capacity * J, glm::mat4(1.0f));
   rot_change_.assign(capacity, 0.0f);
@@ -182,7 +179,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     Scratch s;
     s.rot.resize(2 * kMaxBlendLayers * J);
     s.trans.resize(2 * kMaxBlendLayers * J);
-    s.prev_rot.resize(J);
     return s;
   });
   subtree_end_ = subtree_ends(skeleton_);
@@ -222,14 +218,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   // A crowd's palettes far larger than the caches are written past them (read only by the
   // upload, after the whole crowd is posed); a small crowd's stay cached for it.
   stream_palettes_ = palette_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
-  if (can_twist_) {
-    auto outside = [&](JointRange r) { return hips < r.from || hips >= r.to; };
-    hips_kept_ = outside(twist_range_);
-    for (int side = 0; side < 2; ++side) {
-      hips_kept_ = hips_kept_ && outside(leg_above_ankle_[side]) &&
-                   outside(subtree(skeleton_.ankle(static_cast<Side>(side))));
-    }
-  }
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -331,6 +319,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
   prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
   prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
+  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
 
   // Sample and blend the planned layers.
   PoseLayer layers[2 * kMaxBlendLayers];
@@ -361,8 +350,6 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     }
   }
   std::span<glm::quat> out_r(local_rot_.data() + base, J);
-  // The slot's local rotations still are its last frame's (a held slot keeps them).
-  if (has_prev_[slot]) std::copy_n(out_r.begin(), J, s.prev_rot.begin());
   std::span<glm::vec3> out_t(local_trans_.data() + base, J);
   BlendPosesJob{{layers, static_cast<size_t>(num_layers)}, out_r, out_t}.run();
 
@@ -380,19 +367,15 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   } else {
     fk(slot, 0, num_joints_, root);
   }
-  float pelvis_read = std::numeric_limits<float>::quiet_NaN();
   if (twisting) {
-    pelvis_read = twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
+    twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
   if (locking) lock_feet(pl, P, slot, root, dt);
 
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
-    // The twist read the pelvis heading, and what it and leg IK re-posed left the hips alone.
-    pelvis_heading_[slot] = hips_kept_ && !std::isnan(pelvis_read)
-                                ? pelvis_read
-                                : joint_heading(world_[base + hips], rest_forward_[hips]);
+    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
     upper_heading_[slot] = joint_heading(world_[base + chest], rest_forward_[chest]);
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
@@ -401,7 +384,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
     // Joint 0 carries the root facing, not a local bend.
     change = 2.0f * std::acos(min_abs_dot({local_rot_.data() + base + 1, J - 1},
-                                          {s.prev_rot.data() + 1, J - 1}));
+                                          {prev_local_rot_.data() + base + 1, J - 1}));
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -420,6 +403,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
     }
   }
+  std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   has_prev_[slot] = 1;
   if (make_palettes_) {
     SkinningPaletteJob job;
@@ -432,10 +416,10 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   }
 }
 
-float PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {
+void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {
   const std::vector<int16_t>& chain = skeleton_.spine_chain;
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
-  if (chain.empty() || hips < 0 || chest < 0) return std::numeric_limits<float>::quiet_NaN();
+  if (chain.empty() || hips < 0 || chest < 0) return;
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const float pelvis = joint_heading(world_[base + hips], rest_forward_[hips]);
   const float chest_now = joint_heading(world_[base + chest], rest_forward_[chest]);
@@ -459,7 +443,6 @@ float PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_
     local_rot_[base + j] = glm::normalize(local_rot_[base + j] * corr);
   }
   fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
-  return pelvis;
 }
 
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
@@ -588,7 +571,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // Up fast (a heel that must rise cannot wait long), down slowly; both on springs, so the
     // ankle never turns by more in a frame than a clip's joints do.
     settle_spring(pitch, pitch_rate, reach_pitch,
-                    reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
+                  reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
     // Above the floor it must be at once (a heel below the floor is seen).
     pitch = std::max(pitch, floor_pitch);
     if (pitch > 1e-5f && glm::length(pitch_axis) > 0.5f) {

@@ -47,8 +47,8 @@ class PoseSynthesizer {
   void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
            float dt_s);
   // The same with a PoseDetail per slot (`detail_by_slot`, as uint8_t; capacity long).
-  void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
-           float dt_s, std::span<const uint8_t> detail_by_slot);
+  void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params, float dt_s,
+           std::span<const uint8_t> detail_by_slot);
 
   int num_joints() const { return num_joints_; }
   // World transforms of one slot's joints, as rendered.
@@ -91,8 +91,7 @@ class PoseSynthesizer {
   JointRange subtree(int joint) const;
   // Forward kinematics of two ranges (overlapping ones in one pass).
   void fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root);
-  // Returns the pelvis heading it read [rad] (NaN when it did not twist).
-  float twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
+  void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
   void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
                  float dt);
 
@@ -104,6 +103,7 @@ class PoseSynthesizer {
   std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::quat> local_rot_;
   std::vector<glm::vec3> local_trans_;
+  std::vector<glm::quat> prev_local_rot_;
   std::vector<glm::mat4> world_;
   std::vector<glm::mat4> palette_;
   std::vector<float> rot_change_;
@@ -111,8 +111,8 @@ class PoseSynthesizer {
   std::vector<float> pelvis_heading_;
   std::vector<float> upper_heading_;
   std::vector<uint8_t> has_prev_;
-  std::vector<float> drop_;       // pelvis drop per slot [m]
-  std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
+  std::vector<float> drop_;           // pelvis drop per slot [m]
+  std::vector<float> drop_rate_;      // its rate [m/s] (critically damped spring)
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
@@ -129,8 +129,6 @@ class PoseSynthesizer {
   std::vector<int16_t> pre_twist_joints_;
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
-  // Neither the twist nor leg IK re-poses the hips joint: its heading read by the twist stands.
-  bool hips_kept_ = false;
 };
 
 // The foot's pitch about its toe [rad] that brings the ankle (toe + d, d = ankle - toe) within

@@ -138,8 +138,8 @@ TEST(TwoBoneIKJobReference, SameCorrectionsAsTheAngleBasedSolver) {
   for (int trial = 0; trial < 4000; ++trial) {
     // Bends from a hair off straight (inside and outside the 2 deg pole-plane band) to deep.
     const float bend = trial % 4 == 0 ? 0.1f * u01(rng) : 1.5f * u01(rng);
-    const std::vector<glm::mat4> m = random_leg(rng, 0.4f + 0.1f * u01(rng),
-                                                0.4f + 0.1f * u01(rng), bend);
+    const std::vector<glm::mat4> m =
+        random_leg(rng, 0.4f + 0.1f * u01(rng), 0.4f + 0.1f * u01(rng), bend);
     const glm::vec3 hip = translation_of(m[0]);
     // Targets from close in to beyond full reach (soft and hard clamped).
     const glm::vec3 dir = glm::normalize(glm::vec3(0.6f * u(rng), -1.0f, 0.6f * u(rng)));

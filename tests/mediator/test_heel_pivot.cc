@@ -23,8 +23,8 @@ TEST(HeelOffPivot, SameStepsAsTheMeasuredBisection) {
     const float yaw = 3.14159f * u(rng);
     const glm::vec3 fwd(std::sin(yaw), 0.0f, std::cos(yaw));
     const glm::vec3 toe(u(rng), 0.02f + 0.01f * u(rng), u(rng));
-    const glm::vec3 ankle = toe - fwd * (0.12f + 0.04f * u01(rng)) +
-                            glm::vec3(0.0f, 0.06f + 0.08f * u01(rng), 0.0f);
+    const glm::vec3 ankle =
+        toe - fwd * (0.12f + 0.04f * u01(rng)) + glm::vec3(0.0f, 0.06f + 0.08f * u01(rng), 0.0f);
     const glm::vec3 hip = ankle + fwd * (0.5f * u(rng)) +
                           glm::vec3(0.1f * u(rng), 0.75f + 0.1f * u(rng), 0.1f * u(rng));
     const float reach = glm::length(ankle - hip);
