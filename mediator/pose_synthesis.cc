@@ -68,8 +68,9 @@ float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle_floor)
   return std::clamp(want - now, 0.0f, heel_room(d));
 }
 
-}  // namespace
-
+// The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
+// about the ball, as far as heel_room allows (bisection; the distance shrinks as the heel rises
+// toward the hip). Returns the pitch [rad].
 float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
                      float limit) {
   const glm::vec3 d = ankle - toe;
@@ -110,20 +111,7 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
   return hi;
 }
 
-float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
-                               float limit) {
-  const glm::vec3 d = ankle - toe;
-  const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
-  const float room = heel_room(d);
-  auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
-  if (dist(room) > limit) return room;
-  float lo = 0.0f, hi = room;
-  for (int i = 0; i < 12; ++i) {
-    const float mid = 0.5f * (lo + hi);
-    (dist(mid) > limit ? lo : hi) = mid;
-  }
-  return hi;
-}
+}  // namespace
 
 float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward) {
   // The world matrix's rotation applied to the rest-relative forward (no quaternion needed: the
@@ -629,6 +617,26 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   }
   fk_ranges(slot, use_ik[0] ? subtree(skeleton_.ankle(Side::kLeft)) : JointRange{},
             use_ik[1] ? subtree(skeleton_.ankle(Side::kRight)) : JointRange{}, placed);
+}
+
+float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                     float limit) {
+  return heel_off_pivot(toe, ankle, hip, limit);
+}
+
+float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                               float limit) {
+  const glm::vec3 d = ankle - toe;
+  const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
+  const float room = heel_room(d);
+  auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
+  if (dist(room) > limit) return room;
+  float lo = 0.0f, hi = room;
+  for (int i = 0; i < 12; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (dist(mid) > limit ? lo : hi) = mid;
+  }
+  return hi;
 }
 
 }  // namespace gk

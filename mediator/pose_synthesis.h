@@ -47,8 +47,8 @@ class PoseSynthesizer {
   void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
            float dt_s);
   // The same with a PoseDetail per slot (`detail_by_slot`, as uint8_t; capacity long).
-  void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params, float dt_s,
-           std::span<const uint8_t> detail_by_slot);
+  void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
+           float dt_s, std::span<const uint8_t> detail_by_slot);
 
   int num_joints() const { return num_joints_; }
   // World transforms of one slot's joints, as rendered.
@@ -111,8 +111,8 @@ class PoseSynthesizer {
   std::vector<float> pelvis_heading_;
   std::vector<float> upper_heading_;
   std::vector<uint8_t> has_prev_;
-  std::vector<float> drop_;           // pelvis drop per slot [m]
-  std::vector<float> drop_rate_;      // its rate [m/s] (critically damped spring)
+  std::vector<float> drop_;       // pelvis drop per slot [m]
+  std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
@@ -131,14 +131,14 @@ class PoseSynthesizer {
   bool stream_palettes_ = false;
 };
 
-// The foot's pitch about its toe [rad] that brings the ankle (toe + d, d = ankle - toe) within
-// `limit` [m] of the hip: the heel rises about the ball, as far as the foot may pitch up (at most
-// to about 57 deg of the toe -> ankle line; all of that when even it is not enough). Found by 12
-// bisection steps over that range (the distance shrinks as the heel rises toward the hip), most of
-// them decided by the distance's closed form.
-float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+// The heel-off pivot of leg IK (for tests): the foot's pitch about its toe [rad] that brings the
+// ankle within `limit` [m] of the hip: the heel rises about the ball, as far as the foot may pitch
+// up (at most to about 57 deg of the toe -> ankle line; all of that when even it is not enough).
+// Found by 12 bisection steps over that range (the distance shrinks as the heel rises toward the
+// hip), most of them decided by the distance's closed form.
+float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
                      float limit);
-// The same bisection measuring the distance at every step (the reference of heel_off_pivot).
+// The same bisection measuring the distance at every step (the reference of heel_off_pitch).
 float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
                                float limit);
 

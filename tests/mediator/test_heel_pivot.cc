@@ -29,7 +29,7 @@ TEST(HeelOffPivot, SameStepsAsTheMeasuredBisection) {
                           glm::vec3(0.1f * u(rng), 0.75f + 0.1f * u(rng), 0.1f * u(rng));
     const float reach = glm::length(ankle - hip);
     const float limit = reach * (0.85f + 0.2f * u01(rng));
-    const float fast = heel_off_pivot(toe, ankle, hip, limit);
+    const float fast = heel_off_pitch(toe, ankle, hip, limit);
     const float reference = heel_off_pivot_bisection(toe, ankle, hip, limit);
     ASSERT_EQ(fast, reference) << "trial " << trial;
     if (fast > 0.0f) ++pivoted;
