@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -109,6 +110,49 @@ glm::quat rotation_between(glm::vec3 from, glm::vec3 to) {
   return glm::angleAxis(std::atan2(axis_len, d), axis / axis_len);
 }
 
+// Rotation by the angle whose cosine and sine are proportional to (c, s) (atan2(s, c), any common
+// positive scale) about the unit axis, without the angle: the half-angle quaternion is
+// proportional to (1 + cos, sin axis) = (r + c, s axis) / r. Exact in value; near half a turn
+// (r + c small against r) that cancels, so the angle is taken there.
+glm::quat rotation_of_cos_sin(float c, float s, const glm::vec3& axis) {
+  const float r = std::sqrt(c * c + s * s);
+  if (!(r > 0.0f)) return glm::quat(1, 0, 0, 0);
+  if (r + c < 1e-3f * r) return glm::angleAxis(std::atan2(s, c), axis);
+  return glm::normalize(glm::quat(r + c, s * axis.x, s * axis.y, s * axis.z));
+}
+
+// cos and sin of half of acos(c) for c in [-1, 1] (both >= 0: the angle is in [0, pi]).
+struct HalfAngle {
+  float cos, sin;
+};
+HalfAngle half_of_acos(float c) {
+  return {std::sqrt(std::max(0.0f, 0.5f * (1.0f + c))),
+          std::sqrt(std::max(0.0f, 0.5f * (1.0f - c)))};
+}
+
+// Rotation by acos(c1) - acos(c0) about the unit axis: the half angles' difference by the
+// angle-difference identities (no acos, no sin or cos).
+glm::quat rotation_by_acos_difference(float c1, float c0, const glm::vec3& axis) {
+  const HalfAngle h1 = half_of_acos(c1), h0 = half_of_acos(c0);
+  const float cw = h1.cos * h0.cos + h1.sin * h0.sin;
+  const float sw = h1.sin * h0.cos - h1.cos * h0.sin;
+  return glm::quat(cw, sw * axis.x, sw * axis.y, sw * axis.z);
+}
+
+// rotation_between without the angle: the half-way quaternion (1 + cos, from x to), normalised,
+// is the same rotation (see rotation_of_cos_sin).
+glm::quat rotation_between_fast(glm::vec3 from, glm::vec3 to) {
+  const float lf = glm::length(from), lt = glm::length(to);
+  if (lf < 1e-8f || lt < 1e-8f) return glm::quat(1, 0, 0, 0);
+  from /= lf;
+  to /= lt;
+  const float d = clamp_unit(glm::dot(from, to));
+  const glm::vec3 axis = glm::cross(from, to);
+  const float axis_len = glm::length(axis);
+  if (axis_len < 1e-7f || d < -0.999f) return rotation_between(from, to);
+  return rotation_of_cos_sin(d, axis_len, axis / axis_len);
+}
+
 }  // namespace
 
 float heading_of(const glm::vec3& dir) { return std::atan2(dir.x, dir.z); }
@@ -144,8 +188,11 @@ void SampleClipJob::run() const {
   int i0, i1;
   float t;
   if (clip->loops) {
-    f = std::fmod(f, static_cast<float>(frames));
-    if (f < 0.0f) f += frames;
+    // fmod returns an f already in [0, frames) as it is: skip the call (same bits).
+    if (!(f >= 0.0f && f < static_cast<float>(frames))) {
+      f = std::fmod(f, static_cast<float>(frames));
+      if (f < 0.0f) f += frames;
+    }
     i0 = std::min(static_cast<int>(f), frames - 1);
     i1 = (i0 + 1) % frames;
     t = f - i0;
@@ -267,11 +314,57 @@ bool LocalToModelJob::validate() const {
 void LocalToModelJob::run() const {
   const int n = skeleton->num_joints();
   const int end = to < 0 ? n : std::min(to, n);
-  for (int j = std::max(from, 0); j < end; ++j) {
+  int j = std::max(from, 0);
+#if defined(__SSE2__)
+  // p * [R t; 0 1] as glm's p * local, leaving out the products with the local matrix's zeros
+  // (the sums in glm's order: the same bits). The rotation matrices of four joints at once (they
+  // do not depend on the parents), each lane glm::mat3_cast's operations in its order; each joint
+  // then takes its lane's entries, broadcast, straight from the registers.
+  auto parent_of = [&](int joint) -> const glm::mat4& {
+    const int parent = skeleton->parents[joint];
+    return parent < 0 ? root_transform : out_model[parent];
+  };
+  auto compose = [&](int joint, const __m128* e, auto lane) {
+    constexpr int k = decltype(lane)::value;
+    auto at = [&](int i) { return _mm_shuffle_ps(e[i], e[i], _MM_SHUFFLE(k, k, k, k)); };
+    const glm::mat4& p = parent_of(joint);
+    const __m128 p0 = _mm_loadu_ps(&p[0].x), p1 = _mm_loadu_ps(&p[1].x), p2 = _mm_loadu_ps(&p[2].x),
+                 p3 = _mm_loadu_ps(&p[3].x);
+    auto column = [&](__m128 a, __m128 b, __m128 c) {
+      return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
+    };
+    const glm::vec3& t = translations[joint];
+    float* m = &out_model[joint][0].x;
+    _mm_storeu_ps(m, column(at(0), at(1), at(2)));
+    _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
+    _mm_storeu_ps(m + 8, column(at(6), at(7), at(8)));
+    _mm_storeu_ps(m + 12,
+                  _mm_add_ps(column(_mm_set1_ps(t.x), _mm_set1_ps(t.y), _mm_set1_ps(t.z)), p3));
+  };
+  for (; j + 4 <= end; j += 4) {
+    const Quat4 q = load4(rotations.data() + j);
+    const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
+    const __m128 xx = _mm_mul_ps(q.x, q.x), yy = _mm_mul_ps(q.y, q.y), zz = _mm_mul_ps(q.z, q.z);
+    const __m128 xz = _mm_mul_ps(q.x, q.z), xy = _mm_mul_ps(q.x, q.y), yz = _mm_mul_ps(q.y, q.z);
+    const __m128 wx = _mm_mul_ps(q.w, q.x), wy = _mm_mul_ps(q.w, q.y), wz = _mm_mul_ps(q.w, q.z);
+    const __m128 e[9] = {_mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz))),
+                         _mm_mul_ps(two, _mm_add_ps(xy, wz)),
+                         _mm_mul_ps(two, _mm_sub_ps(xz, wy)),
+                         _mm_mul_ps(two, _mm_sub_ps(xy, wz)),
+                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz))),
+                         _mm_mul_ps(two, _mm_add_ps(yz, wx)),
+                         _mm_mul_ps(two, _mm_add_ps(xz, wy)),
+                         _mm_mul_ps(two, _mm_sub_ps(yz, wx)),
+                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)))};
+    compose(j, e, std::integral_constant<int, 0>{});
+    compose(j + 1, e, std::integral_constant<int, 1>{});
+    compose(j + 2, e, std::integral_constant<int, 2>{});
+    compose(j + 3, e, std::integral_constant<int, 3>{});
+  }
+#endif
+  for (; j < end; ++j) {
     const int parent = skeleton->parents[j];
     const glm::mat4& p = parent < 0 ? root_transform : out_model[parent];
-    // p * [R t; 0 1], leaving out the products with the local matrix's zeros (the sums keep glm's
-    // order, so the result is glm's p * local to the bit).
     const glm::mat3 r = glm::mat3_cast(rotations[j]);
     const glm::vec3& t = translations[j];
     glm::mat4& m = out_model[j];
@@ -318,16 +411,15 @@ void TwoBoneIKJob::run() const {
   const float lat = std::clamp(soft_reach, min_len, std::max(min_len, max_len));
   if (out_reached) *out_reached = reach <= max_len && reach >= min_len;
 
-  // Current and desired interior angles.
+  // Current and desired interior angles, by their cosines (the rotations by their differences
+  // need no angle: rotation_by_acos_difference).
   const glm::vec3 ab = glm::normalize(b - a), bc = glm::normalize(c - b);
   if (lac < 1e-6f) return;
   const glm::vec3 ac_n = ac / lac;
-  const float ac_ab_0 = std::acos(clamp_unit(glm::dot(ac_n, ab)));
-  const float ba_bc_0 = std::acos(clamp_unit(glm::dot(-ab, bc)));
-  const float ac_ab_1 =
-      std::acos(clamp_unit((lcb * lcb - lab * lab - lat * lat) / (-2.0f * lab * lat)));
-  const float ba_bc_1 =
-      std::acos(clamp_unit((lat * lat - lab * lab - lcb * lcb) / (-2.0f * lab * lcb)));
+  const float cos_hip_0 = clamp_unit(glm::dot(ac_n, ab));
+  const float cos_knee_0 = clamp_unit(glm::dot(-ab, bc));
+  const float cos_hip_1 = clamp_unit((lcb * lcb - lab * lab - lat * lat) / (-2.0f * lab * lat));
+  const float cos_knee_1 = clamp_unit((lat * lat - lab * lab - lcb * lcb) / (-2.0f * lab * lcb));
 
   // Bend plane normal: the current plane of the limb, or the pole plane when the limb is straight
   // or within 2 deg of it (its own plane may then point either way from frame to frame, and the
@@ -335,24 +427,31 @@ void TwoBoneIKJob::run() const {
   // In the pole's plane the limb's present bend counts by its share along that plane's normal
   // (negative when it bends away from the pole): continuous as the limb straightens.
   glm::vec3 axis0 = glm::cross(ac_n, ab);
-  float hip_0 = ac_ab_0, knee_0 = ba_bc_0;
   const float own = glm::length(axis0);
   const glm::vec3 pole_axis = glm::cross(ac_n, pole);
-  if (own < kStraightLimb && glm::length(pole_axis) >= 1e-5f) {
+  const bool in_pole_plane = own < kStraightLimb && glm::length(pole_axis) >= 1e-5f;
+  float along = 0.0f;
+  if (in_pole_plane) {
     const glm::vec3 n = glm::normalize(pole_axis);
-    const float along = own > 1e-9f ? glm::dot(axis0 / own, n) : 0.0f;
-    hip_0 = along * ac_ab_0;
-    knee_0 = kPi - along * (kPi - ba_bc_0);
+    along = own > 1e-9f ? glm::dot(axis0 / own, n) : 0.0f;
     axis0 = n;
   }
   if (glm::length(axis0) < 1e-5f) axis0 = glm::cross(ac_n, glm::vec3(1, 0, 0));
   axis0 = glm::normalize(axis0);
 
-  const glm::quat r_bend = glm::angleAxis(ac_ab_1 - hip_0, axis0);
-  const glm::quat r_knee = glm::angleAxis(ba_bc_1 - knee_0, axis0);
+  glm::quat r_bend, r_knee;
+  if (in_pole_plane) {  // the present bend scaled by its share: the angles themselves
+    const float hip_0 = along * std::acos(cos_hip_0);
+    const float knee_0 = kPi - along * (kPi - std::acos(cos_knee_0));
+    r_bend = glm::angleAxis(std::acos(cos_hip_1) - hip_0, axis0);
+    r_knee = glm::angleAxis(std::acos(cos_knee_1) - knee_0, axis0);
+  } else {
+    r_bend = rotation_by_acos_difference(cos_hip_1, cos_hip_0, axis0);
+    r_knee = rotation_by_acos_difference(cos_knee_1, cos_knee_0, axis0);
+  }
   // End joint after the bend, then swing the chain onto the target direction.
   const glm::vec3 c1 = a + r_bend * (b - a) + r_bend * (r_knee * (c - b));
-  const glm::quat r_swing = rotation_between(c1 - a, target - a);
+  const glm::quat r_swing = rotation_between_fast(c1 - a, target - a);
   glm::quat r = r_swing * r_bend;
 
   // Twist about the start-target axis so the knee points toward the pole.
@@ -361,9 +460,9 @@ void TwoBoneIKJob::run() const {
   const glm::vec3 knee_p = knee - axis_t * glm::dot(knee, axis_t);
   const glm::vec3 pole_p = pole - axis_t * glm::dot(pole, axis_t);
   if (glm::length(knee_p) > 1e-5f && glm::length(pole_p) > 1e-5f) {
-    const float twist =
-        std::atan2(glm::dot(glm::cross(knee_p, pole_p), axis_t), glm::dot(knee_p, pole_p));
-    r = glm::angleAxis(twist, axis_t) * r;
+    r = rotation_of_cos_sin(glm::dot(knee_p, pole_p), glm::dot(glm::cross(knee_p, pole_p), axis_t),
+                            axis_t) *
+        r;
   }
 
   const glm::quat qa = glm::quat_cast(glm::mat3(start_model));
@@ -418,6 +517,27 @@ void SkinningPaletteJob::run() const {
     m[2] = a[0] * b[2][0] + a[1] * b[2][1] + a[2] * b[2][2];
     m[3] = a[0] * b[3][0] + a[1] * b[3][1] + a[2] * b[3][2] + a[3];
   }
+}
+
+float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b) {
+  const size_t n = std::min(a.size(), b.size());
+  float d_min = 1.0f;
+  size_t j = 0;
+#if defined(__SSE2__)
+  if (n >= 4) {
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 m = _mm_set1_ps(1.0f);
+    for (; j + 4 <= n; j += 4) {
+      // min(x, m) keeps m where x is NaN, as std::min(m, x) does.
+      m = _mm_min_ps(_mm_and_ps(dot4(load4(a.data() + j), load4(b.data() + j)), abs_mask), m);
+    }
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, m);
+    d_min = std::min(std::min(lanes[0], lanes[1]), std::min(lanes[2], lanes[3]));
+  }
+#endif
+  for (; j < n; ++j) d_min = std::min(d_min, std::abs(glm::dot(a[j], b[j])));
+  return d_min;
 }
 
 bool is_affine(std::span<const glm::mat4> matrices) {

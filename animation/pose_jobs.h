@@ -106,6 +106,10 @@ struct SkinningPaletteJob {
   void run() const;
 };
 
+// The smallest |dot(a[j], b[j])| over j (1 when empty): the largest angle between two poses'
+// rotations is 2 acos of it. Four joints at a time, glm's dot to the bit.
+float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b);
+
 // True when every matrix's bottom row is exactly 0 0 0 1.
 bool is_affine(std::span<const glm::mat4> matrices);
 

@@ -35,11 +35,18 @@ constexpr float kDropHalflife = 0.05f;  // [s]
 // A raised heel puts the toe -> ankle line at most this steep [rad] (about 57 deg, a stance
 // foot's plantarflexion at toe-off): the pivot never turns a foot past standing on its tip.
 constexpr float kMaxHeelOff = 1.0f;
+constexpr float kPi = 3.14159265358979f;
 
 // Legs straighten smoothly over the last part of their reach (soft IK): near full extension a
 // knee's position changes ever faster with the foot's distance, and a hard clamp snaps it.
 constexpr float kIkMaxExtension = 0.999f;
 constexpr float kIkSoften = 0.98f;
+
+// critical_spring, skipped (its exp too) when it is at rest on a goal of 0: it would stay there.
+void settle_spring(float& x, float& v, float goal, float halflife_s, float dt) {
+  if (x == 0.0f && v == 0.0f && goal == 0.0f) return;
+  critical_spring(x, v, goal, halflife_s, dt);
+}
 
 // How much more the foot may pitch up from its elevation (toe -> ankle vector d) [rad].
 float heel_room(const glm::vec3& d) {
@@ -71,10 +78,35 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
   const float room = heel_room(d);
   auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
   if (dist(room) > limit) return room;
+  // Each step asks whether dist(mid) > limit. The axis is square to d, so the squared distance
+  // is K + A cos a + B sin a = K + M cos(a - phi): it exceeds limit^2 where |a - phi| (wrapped)
+  // is below acos((limit^2 - K) / M). Far from that boundary the answer is certain without the
+  // rotation; within kSure of it, and near a tangency where the boundary is ill-conditioned,
+  // the step measures dist as before, so the steps, and the pitch, are the same.
+  constexpr float kSure = 1e-3f;  // [rad], against an analytic error of about 1e-5 rad
+  const glm::vec3 e = toe - hip;
+  const glm::vec3 w = glm::cross(axis, d);
+  const float k = glm::dot(e, e) + glm::dot(d, d);
+  const float a_cos = 2.0f * glm::dot(e, d), b_sin = 2.0f * glm::dot(e, w);
+  const float m = std::sqrt(a_cos * a_cos + b_sin * b_sin);
+  const float c = m > 1e-6f ? (limit * limit - k) / m : 2.0f;
+  const bool analytic = std::abs(c) < 1.0f - 1e-3f;
+  const float phi = analytic ? std::atan2(b_sin, a_cos) : 0.0f;
+  const float half_width = analytic ? std::acos(c) : 0.0f;
+  auto beyond = [&](float a) {
+    if (analytic) {
+      float delta = a - phi;
+      if (delta > kPi) delta -= 2.0f * kPi;
+      if (delta < -kPi) delta += 2.0f * kPi;
+      const float margin = half_width - std::abs(delta);
+      if (std::abs(margin) > kSure) return margin > 0.0f;
+    }
+    return dist(a) > limit;
+  };
   float lo = 0.0f, hi = room;
   for (int i = 0; i < 12; ++i) {
     const float mid = 0.5f * (lo + hi);
-    (dist(mid) > limit ? lo : hi) = mid;
+    (beyond(mid) ? lo : hi) = mid;
   }
   return hi;
 }
@@ -338,11 +370,9 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   float change = 0.0f;
   if (has_prev_[slot] && J > 1) {
     // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
-    float d_min = 1.0f;
-    for (size_t j = 1; j < J; ++j) {  // joint 0 carries the root facing, not a local bend
-      d_min = std::min(d_min, std::abs(glm::dot(local_rot_[base + j], prev_local_rot_[base + j])));
-    }
-    change = 2.0f * std::acos(d_min);
+    // Joint 0 carries the root facing, not a local bend.
+    change = 2.0f * std::acos(min_abs_dot({local_rot_.data() + base + 1, J - 1},
+                                          {prev_local_rot_.data() + base + 1, J - 1}));
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -460,13 +490,15 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     if (dx < reach && dy > 0.0f) needed = std::max(needed, dy - std::sqrt(reach * reach - dx * dx));
   }
   if (pl.fresh[slot]) drop_[slot] = drop_rate_[slot] = 0.0f;
-  critical_spring(drop_[slot], drop_rate_[slot], std::min(needed, kMaxDrop), kDropHalflife, dt);
+  settle_spring(drop_[slot], drop_rate_[slot], std::min(needed, kMaxDrop), kDropHalflife, dt);
   drop_[slot] = std::clamp(drop_[slot], 0.0f, kMaxDrop);
   const float drop = drop_[slot];
   glm::mat4 placed = root;
   placed[3].y -= drop;
   // Lowering the root lowers every joint by the same amount: no need for a second FK pass.
-  for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
+  if (drop != 0.0f) {
+    for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
+  }
 
   glm::quat ankle_world_rot[2];
   bool use_ik[2] = {false, false};
@@ -486,7 +518,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     use_ik[side] = glm::dot(toe_offset[side], toe_offset[side]) > 1e-10f ||
                    drawn_ankle.y + toe_offset[side].y < library_.planted_ankle_m[side] ||
                    locks_.heel_pitch[static_cast<size_t>(slot) * 2 + side] > 0.0f;
-    ankle_world_rot[side] = rotation_of(world_[base + ankle]);
+    if (use_ik[side]) ankle_world_rot[side] = rotation_of(world_[base + ankle]);
   }
   if (!use_ik[0] && !use_ik[1]) return;
   for (int side = 0; side < 2; ++side) {
@@ -526,8 +558,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     }
     // Up fast (a heel that must rise cannot wait long), down slowly; both on springs, so the
     // ankle never turns by more in a frame than a clip's joints do.
-    critical_spring(pitch, pitch_rate, reach_pitch,
-                    reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
+    settle_spring(pitch, pitch_rate, reach_pitch,
+                  reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
     // Above the floor it must be at once (a heel below the floor is seen).
     pitch = std::max(pitch, floor_pitch);
     if (pitch > 1e-5f && glm::length(pitch_axis) > 0.5f) {
@@ -572,8 +604,10 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   }
   fk_ranges(slot, use_ik[0] ? leg_above_ankle_[0] : JointRange{},
             use_ik[1] ? leg_above_ankle_[1] : JointRange{}, placed);
-  // Restore each ankle's world orientation under its new shin, then finish the feet.
+  // Restore each ankle's world orientation under its new shin, then finish the feet. A leg
+  // without IK keeps its shin, ankle and foot as posed.
   for (int side = 0; side < 2; ++side) {
+    if (!use_ik[side]) continue;
     const Side sd = static_cast<Side>(side);
     const int ankle = skeleton_.ankle(sd);
     const int parent = skeleton_.parents[ankle];
@@ -581,8 +615,28 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
     local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
   }
-  fk_ranges(slot, subtree(skeleton_.ankle(Side::kLeft)), subtree(skeleton_.ankle(Side::kRight)),
-            placed);
+  fk_ranges(slot, use_ik[0] ? subtree(skeleton_.ankle(Side::kLeft)) : JointRange{},
+            use_ik[1] ? subtree(skeleton_.ankle(Side::kRight)) : JointRange{}, placed);
+}
+
+float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                     float limit) {
+  return heel_off_pivot(toe, ankle, hip, limit);
+}
+
+float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                               float limit) {
+  const glm::vec3 d = ankle - toe;
+  const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
+  const float room = heel_room(d);
+  auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
+  if (dist(room) > limit) return room;
+  float lo = 0.0f, hi = room;
+  for (int i = 0; i < 12; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (dist(mid) > limit ? lo : hi) = mid;
+  }
+  return hi;
 }
 
 }  // namespace gk

@@ -131,6 +131,17 @@ class PoseSynthesizer {
   bool stream_palettes_ = false;
 };
 
+// The heel-off pivot of leg IK (for tests): the foot's pitch about its toe [rad] that brings the
+// ankle within `limit` [m] of the hip: the heel rises about the ball, as far as the foot may pitch
+// up (at most to about 57 deg of the toe -> ankle line; all of that when even it is not enough).
+// Found by 12 bisection steps over that range (the distance shrinks as the heel rises toward the
+// hip), most of them decided by the distance's closed form.
+float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                     float limit);
+// The same bisection measuring the distance at every step (the reference of heel_off_pitch).
+float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                               float limit);
+
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
 // +z; rest_forward is that +z in the joint's own frame): heading [rad].
 float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward);

@@ -32,8 +32,12 @@ inline float smoothstep01(float x) {
 
 inline float wrap_pi(float a) {
   constexpr float kPi = std::numbers::pi_v<float>;
-  a = std::fmod(a + kPi, 2.0f * kPi);
-  if (a < 0.0f) a += 2.0f * kPi;
+  a += kPi;
+  // fmod returns an x already in [0, y) as it is: skip the call (same bits).
+  if (!(a >= 0.0f && a < 2.0f * kPi)) {
+    a = std::fmod(a, 2.0f * kPi);
+    if (a < 0.0f) a += 2.0f * kPi;
+  }
   return a - kPi;
 }
 
