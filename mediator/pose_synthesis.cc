@@ -125,6 +125,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   drop_.assign(capacity, 0.0f);
   drop_rate_.assign(capacity, 0.0f);
   placed_xz_.assign(capacity, glm::vec2(0.0f));
+  root_offset_.assign(capacity, glm::vec2(0.0f));
   locks_.lock.assign(capacity * 2, FootLock());
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
@@ -205,24 +206,13 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
   });
 }
 
-// An agent not posed this frame: its world joints, palette and foot positions move with the
-// root's ground translation since they were placed (one add per matrix; the facing and the pose
-// wait for the next update).
+// An agent not posed this frame: its world joints and palette stay where they were posed and are
+// drawn root_offset further on (the root's ground walk since; the facing and the pose wait for the
+// next update). Its toes as the foot locks know them move with it.
 void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
-  const glm::vec2 delta = pl.root_xz[slot] - placed_xz_[slot];
-  if (delta.x == 0.0f && delta.y == 0.0f) return;
-  placed_xz_[slot] = pl.root_xz[slot];
-  const size_t base = static_cast<size_t>(slot) * num_joints_;
-  for (int j = 0; j < num_joints_; ++j) {
-    world_[base + j][3].x += delta.x;
-    world_[base + j][3].z += delta.y;
-  }
-  if (make_palettes_) {
-    for (int j = 0; j < num_joints_; ++j) {
-      palette_[base + j][3].x += delta.x;
-      palette_[base + j][3].z += delta.y;
-    }
-  }
+  const glm::vec2 offset = pl.root_xz[slot] - placed_xz_[slot];
+  const glm::vec2 delta = offset - root_offset_[slot];
+  root_offset_[slot] = offset;
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     locks_.drawn_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
@@ -313,6 +303,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool locking = apm && P.foot_locking && detail == PoseDetail::kFull;
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   placed_xz_[slot] = pl.root_xz[slot];
+  root_offset_[slot] = glm::vec2(0.0f);
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   const bool twisting = apm && detail != PoseDetail::kLight;
   if (twisting && can_twist_) {

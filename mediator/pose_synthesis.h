@@ -25,7 +25,7 @@ enum class PoseDetail : uint8_t {
   kFull = 0,         // everything: spine twist, foot locks and leg IK
   kNoFootLocks = 1,  // spine twist, no foot locks (they start afresh from the drawn toes)
   kLight = 2,        // no spine twist, no foot locks
-  kHold = 3,         // not posed: the last pose moves with the root (root_xz) to where it is now
+  kHold = 3,         // not posed: the last pose is drawn where the root (root_xz) is now
 };
 
 // Per foot [slot * 2 + side].
@@ -51,12 +51,26 @@ class PoseSynthesizer {
            float dt_s, std::span<const uint8_t> detail_by_slot);
 
   int num_joints() const { return num_joints_; }
-  // World transforms of one slot's joints, as rendered.
+  // World transforms of one slot's joints where they were last posed. A slot held this frame
+  // (PoseDetail::kHold) is drawn root_offset(slot) further on: add it to the translations (or use
+  // joint_position), as the renderer does per instance.
   std::span<const glm::mat4> world(int slot) const {
     return {world_.data() + static_cast<size_t>(slot) * num_joints_,
             static_cast<size_t>(num_joints_)};
   }
-  // Every slot's skinning palette, slot after slot (empty without make_palettes).
+  // Ground displacement (x, z) [m] from where a slot's world joints and palette were posed to where
+  // it is drawn now: (0, 0) for a slot posed this frame; for a held one, its root's walk since its
+  // last pose. A held agent costs O(1) this way, not a move of every joint's matrix.
+  glm::vec2 root_offset(int slot) const { return root_offset_[slot]; }
+  std::span<const glm::vec2> root_offsets() const { return root_offset_; }
+  // One joint's world position as drawn this frame (world(slot)'s translation + root_offset).
+  glm::vec3 joint_position(int slot, int joint) const {
+    const glm::vec4& t = world_[static_cast<size_t>(slot) * num_joints_ + joint][3];
+    const glm::vec2 o = root_offset_[slot];
+    return {t.x + o.x, t.y, t.z + o.y};
+  }
+  // Every slot's skinning palette, slot after slot (empty without make_palettes); drawn with
+  // root_offset added to their translations, like world().
   std::span<const glm::mat4> palettes() const { return palette_; }
   std::span<const glm::mat4> palette(int slot) const {
     return {palette_.data() + static_cast<size_t>(slot) * num_joints_,
@@ -114,6 +128,7 @@ class PoseSynthesizer {
   std::vector<float> drop_;       // pelvis drop per slot [m]
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
+  std::vector<glm::vec2> root_offset_;  // root_offset(slot)
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   std::vector<int> subtree_end_;  // subtree_ends(skeleton_)
