@@ -14,6 +14,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "mediator/animation_plans.h"
+#include "mediator/coarse_pose.h"
 #include "mediator/foot_lock.h"
 #include "mediator/locomotion_library.h"
 #include "mediator/params.h"
@@ -24,7 +25,7 @@ namespace gk {
 enum class PoseDetail : uint8_t {
   kFull = 0,         // everything: spine twist, foot locks and leg IK
   kNoFootLocks = 1,  // spine twist, no foot locks (they start afresh from the drawn toes)
-  kLight = 2,        // no spine twist, no foot locks
+  kLight = 2,        // no spine twist, no foot locks, coarse joints only (mediator/coarse_pose.h)
   kHold = 3,         // not posed: the last pose is drawn where the root (root_xz) is now
 };
 
@@ -81,7 +82,7 @@ class PoseSynthesizer {
             static_cast<size_t>(num_joints_)};
   }
   // Largest change of any joint's local rotation since the slot's previous frame [rad] (0 on an
-  // agent's first frame).
+  // agent's first frame, and on a frame posed PoseDetail::kLight or right after one).
   float max_rotation_change(int slot) const { return rot_change_[slot]; }
   const FootLocks& foot_locks() const { return locks_; }
   // Final torsion pelvis -> chest [rad], signed, per slot.
@@ -96,6 +97,8 @@ class PoseSynthesizer {
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
+  void pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot, Scratch& s);
+  void finish_pose(int slot, PoseDetail detail, bool locking);
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
   void fk(int slot, int from, int to, const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
@@ -125,6 +128,7 @@ class PoseSynthesizer {
   std::vector<float> pelvis_heading_;
   std::vector<float> upper_heading_;
   std::vector<uint8_t> has_prev_;
+  std::vector<uint8_t> prev_rot_valid_;  // prev_local_rot_ holds the slot's last posed rotations
   std::vector<float> drop_;       // pelvis drop per slot [m]
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
@@ -142,6 +146,7 @@ class PoseSynthesizer {
   bool can_twist_ = false;
   JointRange twist_range_;
   std::vector<int16_t> pre_twist_joints_;
+  CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
 };
