@@ -16,6 +16,7 @@
 #include "tests/mediator/mediator_fixture.h"
 #include "tests/mediator/scripted_crowd.h"
 #include "tests/pipeline/allocation_counter.h"
+#include "tests/test_data.h"
 
 namespace gk {
 namespace {
@@ -101,7 +102,8 @@ TEST(LodPolicy, AgentsOfALevelAreSpreadEvenlyOverItsPeriod) {
     for (int level = 0; level < kNumLodLevels; ++level) {
       EXPECT_EQ(policy.counts()[level], 250);
       // 250 agents over a period of P frames: 250 / P each frame, give or take one.
-      EXPECT_NEAR(due[level], 250.0 / kLodPeriod[level], 1.0) << "level " << level << " frame " << f;
+      EXPECT_NEAR(due[level], 250.0 / kLodPeriod[level], 1.0)
+          << "level " << level << " frame " << f;
     }
   }
   // Over 8 frames every agent is updated exactly 8 / period times.
@@ -229,17 +231,17 @@ std::vector<glm::vec3> drawn_joints(const PoseSynthesizer& poses, int slot) {
 // Without LOD, its largest joint step from one frame to the next (a swinging foot) is one frame of
 // its motion, M, itself within what a walk at speed s allows (kLimbSpeedFactor * s +
 // kLimbSpeedMargin per second). With LOD no joint may move from one frame to the next by more than
-// the frames since the agent's last update times M (to 10%), plus kLevelChangeSlack at a level change (the
-// foot locks' last IK offsets, at most a few cm, are let go when the agent leaves level 0).
-TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
+// the frames since the agent's last update times M (to 10%), plus kLevelChangeSlack at a level
+// change (the foot locks' last IK offsets, at most a few cm, are let go when the agent leaves level
+// 0).
+void expect_no_joint_jumps(const LocomotionLibrary& lib, bool check_level0_changes = true) {
   constexpr float kLimbSpeedFactor = 6.0f;
-  constexpr float kLimbSpeedMargin = 0.5f;  // [m/s]
+  constexpr float kLimbSpeedMargin = 0.5f;    // [m/s]
   constexpr float kLevelChangeSlack = 0.03f;  // [m]
   // The two runs' feet lock at slightly different moments (with LOD the locks start afresh on
   // entering level 0), so the largest step of one is the other's to within this factor.
   constexpr float kMotionMargin = 1.1f;
   const float speed = 1.4f;
-  const LocomotionLibrary& lib = test::builtin_library();
   float frame_motion = 0.0f;  // M [m]
   for (bool use_lod : {false, true}) {
     SCOPED_TRACE(use_lod ? "LOD" : "no LOD");
@@ -261,10 +263,20 @@ TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
         if (!use_lod) {
           frame_motion = std::max(frame_motion, step);
         } else {
-          const float bound = static_cast<float>(frames_since_update) * kMotionMargin * frame_motion +
-                              (changed ? kLevelChangeSlack : 0.0f);
-          ASSERT_LE(step, bound) << "frame " << f << " level " << level << " (was " << last_level
-                                 << ", " << frames_since_update << " frames since the last update)";
+          const float bound =
+              static_cast<float>(frames_since_update) * kMotionMargin * frame_motion +
+              (changed ? kLevelChangeSlack : 0.0f);
+          size_t worst = 0;
+          for (size_t j = 0; j < world.size(); ++j) {
+            if (glm::length(world[j] - last[j]) > glm::length(world[worst] - last[worst]))
+              worst = j;
+          }
+          const bool level0_change = changed && std::min(level, last_level) == 0;
+          if (!level0_change || check_level0_changes) {
+            ASSERT_LE(step, bound) << "joint " << lib.skeleton->names[worst] << " frame " << f
+                                   << " level " << level << " (was " << last_level << ", "
+                                   << frames_since_update << " frames since the last update)";
+          }
         }
       }
       changes += changed && f > 1;  // frame 1: the newcomer takes its level
@@ -280,6 +292,22 @@ TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
       EXPECT_EQ(changes, 6);  // 3 -> 2 -> 1 -> 0 -> 1 -> 2 -> 3
     }
   }
+}
+
+TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
+  expect_no_joint_jumps(test::builtin_library());
+}
+
+// The same with the 53-joint mannequin, whose fingers and toes levels 2 and 3 leave out (they
+// follow their parents in the standing pose there): entering and leaving those levels moves them
+// no more than the slack. Open, not checked here: leaving level 0, the mannequin's foot locks can
+// let go of more than the slack at once (a foot about 8 cm beyond it, as before the coarse
+// joints: levels 0 and 1 pose every joint).
+TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumpsWithCoarseJoints) {
+  GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
+  auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  expect_no_joint_jumps(*lib, /*check_level0_changes=*/false);
 }
 
 // Per-frame code allocates nothing, with LOD too (walkers over every level, metrics on).
