@@ -140,7 +140,10 @@ void CrowdSession::collect_lane(AnimationLane* lane) const {
   for (size_t i = 0; i < n; ++i) {
     const int slot = plans.slot_of_agent[i];
     const glm::vec2 root = plans.root_xz[slot];
-    lane->draws[i] = AgentDraw{glm::vec3(root.x, 0.0f, root.y), agent_tint(frame.ids[i]), 0, slot};
+    // A held pose (level of detail) is drawn where its root is now, not where it was posed.
+    const glm::vec2 offset = pipeline.poses().root_offset(slot);
+    lane->draws[i] = AgentDraw{glm::vec3(root.x, 0.0f, root.y), agent_tint(frame.ids[i]), 0, slot,
+                               glm::vec3(offset.x, 0.0f, offset.y)};
   }
   lane->num_collected = n;
   lane->num_palettes = pipeline.num_slots();

@@ -47,7 +47,7 @@ void LiveMetrics::record(const CrowdSession& session, const AnimationLane& lane,
     torsion += std::abs(lane.poses().torsion(slot));
     rate += plans.playback_rate[slot];
     // The rendered root is the skeleton's root joint (the pelvis) projected on the ground.
-    const glm::vec3 pelvis(lane.poses().world(slot)[0][3]);
+    const glm::vec3 pelvis = lane.poses().joint_position(slot, 0);
     root_error += glm::length(glm::vec2(pelvis.x, pelvis.z) - frame.positions[i]);
   }
   const double n = frame.size() ? static_cast<double>(frame.size()) : 1.0;

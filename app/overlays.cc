@@ -204,15 +204,18 @@ void OverlayHistory::record(const CrowdSession& session, const AnimationLane& la
     if (slot >= capacity_) continue;
     if (slot_id_[slot] != frame.ids[i]) slot_id_[slot] = frame.ids[i], count_[slot] = 0;
     const int k = count_[slot];
-    const auto world = lane.poses().world(static_cast<int>(slot));
+    const PoseSynthesizer& poses = lane.poses();
+    const int pose_slot = static_cast<int>(slot);
     float rel[2] = {1e9f, 1e9f};
     for (int s = 0; s < 2; ++s) {
-      if (toe_joint_[s] >= 0) rel[s] = world[toe_joint_[s]][3].y - toe_floor_m_[s];
+      if (toe_joint_[s] >= 0) {
+        rel[s] = poses.joint_position(pose_slot, toe_joint_[s]).y - toe_floor_m_[s];
+      }
     }
     const int support = rel[1] < rel[0] ? 1 : 0;
     for (int s = 0; s < 2; ++s) {
       if (toe_joint_[s] < 0) continue;
-      const glm::vec3 p(world[toe_joint_[s]][3]);
+      const glm::vec3 p = poses.joint_position(pose_slot, toe_joint_[s]);
       ToeSample* ring = &toes_[(slot * 2 + s) * kTrailLength];
       ToeSample& cur = ring[k % kTrailLength];
       const ToeSample& prev = ring[(k + kTrailLength - 1) % kTrailLength];

@@ -61,9 +61,8 @@ Status JointDumpWriter::write_frame(int frame, double time_s, const AgentFrame& 
                                     const Mediator& mediator, const PoseSynthesizer& poses) {
   for (size_t i = 0; i < agents.size(); ++i) {
     const int slot = mediator.plans().slot_of_agent[i];
-    const auto world = poses.world(slot);
     for (size_t k = 0; k < joints_.size(); ++k) {
-      const glm::vec3 p = translation_of(world[joints_[k]]);
+      const glm::vec3 p = poses.joint_position(slot, joints_[k]);
       // Each float as the exact decimal of its double value (17 digits): a reader that
       // parses doubles gets the very numbers the metrics used, so ties between feet break alike.
       std::fprintf(file_, "%d,%.9g,%u,%s,%.17g,%.17g,%.17g\n", frame, time_s, agents.ids[i],

@@ -80,6 +80,8 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   lod_elapsed_s_.assign(capacity, 0.0f);
   lod_phase_advance_.assign(capacity, 0.0f);
   lod_tr_advance_.assign(capacity, 0.0f);
+  lod_cycles_per_s_.assign(capacity, 0.0f);
+  lod_cycles_valid_.assign(capacity, 0);
   lod_root_at_plan_.assign(capacity, glm::vec2(0.0f));
 }
 
@@ -210,6 +212,10 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   // planned over the time since its last plan.
   AnimationPlans& pl = plans_;
   const bool lod = !lod_due_.empty();
+  // Plans made without LOD kept no gait frequency for the advance.
+  if (lod && !lod_was_on_) std::fill(lod_cycles_valid_.begin(), lod_cycles_valid_.end(), 0);
+  lod_was_on_ = lod;
+  const float pull = root_pull(dt_s);
   if (lod) {
     // Per agent and its own slot only: in parallel, as the passes.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -220,7 +226,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
           lod_dt_s_[slot] = lod_step(slot, dt_s);
         } else {
           advance_agent(static_cast<int>(i), slot, frame.positions[i], frame.velocities[i],
-                        frame.thetas[i], dt_s);
+                        frame.thetas[i], dt_s, pull);
         }
       }
     });
@@ -265,6 +271,10 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
       if (!lod_plan_[slot]) continue;
       lod_root_at_plan_[slot] = pl.root_xz[slot];
       lod_elapsed_s_[slot] = lod_phase_advance_[slot] = lod_tr_advance_[slot] = 0.0f;
+      const GaitFrequency gf = gait_frequency(library_, &pl.layer_clip[slot * kMaxBlendLayers],
+                                              &pl.layer_weight[slot * kMaxBlendLayers]);
+      lod_cycles_per_s_[slot] = gf.gait_weight > 0.0f ? gf.cycles_per_s : 0.0f;
+      lod_cycles_valid_[slot] = 1;
     }
   }
   return Status::Ok();
@@ -274,7 +284,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
 // its last plan, and its root follows p as the root pass's would (pulled_root). Clips, weights,
 // facing and springs wait for its next plan.
 void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const glm::vec2& v_in,
-                             float theta_in, float dt) {
+                             float theta_in, float dt, float pull) {
   AnimationPlans& pl = plans_;
   const glm::vec2 p = usable_position(p_in) ? p_in : pl.root_xz[slot];
   glm::vec2 v = finite2(v_in) ? v_in : vel_[slot];
@@ -288,15 +298,20 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
   feedback_.velocities[agent] = v;
   feedback_.thetas[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];
   pl.root_xz[slot] = params_.mode == MediatorMode::kApm
-                         ? pulled_root(pl.root_xz[slot], vel_[slot], p, dt)
+                         ? pulled_root(pl.root_xz[slot], vel_[slot], p, dt, pull)
                          : p;
-  // The gait frequency of the planned blend, as the rate and phase pass takes it.
+  // The gait frequency of the planned blend, as the rate and phase pass takes it (kept from the
+  // agent's last plan: its layers and weights have not changed since).
   const int16_t* lc = &pl.layer_clip[slot * kMaxBlendLayers];
   const float* lw = &pl.layer_weight[slot * kMaxBlendLayers];
   float* lt = &pl.layer_time_s[slot * kMaxBlendLayers];
-  const GaitFrequency gf = gait_frequency(library_, lc, lw);
-  if (gf.gait_weight > 0.0f) {
-    const float step = gf.cycles_per_s * pl.playback_rate[slot] * dt;
+  if (!lod_cycles_valid_[slot]) {
+    const GaitFrequency gf = gait_frequency(library_, lc, lw);
+    lod_cycles_per_s_[slot] = gf.gait_weight > 0.0f ? gf.cycles_per_s : 0.0f;
+    lod_cycles_valid_[slot] = 1;
+  }
+  if (lod_cycles_per_s_[slot] > 0.0f) {
+    const float step = lod_cycles_per_s_[slot] * pl.playback_rate[slot] * dt;
     pl.phase[slot] = std::fmod(pl.phase[slot] + step, 1.0f);
     lod_phase_advance_[slot] += step;
   }
@@ -310,7 +325,10 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
     tr_time_[slot] = std::min(before + tr_rate_[slot] * dt, end);
     lod_tr_advance_[slot] += tr_time_[slot] - before;
   }
+  // Only the layers pose synthesis samples (weight > 0); the contacts pass sets them all again
+  // at the next plan.
   for (int k = 0; k < kMaxBlendLayers; ++k) {
+    if (lw[k] <= 0.0f) continue;
     lt[k] = layer_time(library_.clips[lc[k]], pl.phase[slot], idle_time_[slot], tr_time_[slot]);
   }
 }

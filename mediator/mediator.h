@@ -93,7 +93,7 @@ class Mediator {
   // LOD: an agent that is not due this frame (set_lod_due) is advanced, not planned; the step a
   // due one is planned over (the time since its last plan).
   void advance_agent(int agent, int slot, const glm::vec2& p, const glm::vec2& v, float theta,
-                     float dt);
+                     float dt, float pull);
   float lod_step(int slot, float dt);
 
   const LocomotionLibrary& library_;
@@ -138,6 +138,11 @@ class Mediator {
   std::vector<uint8_t> lod_plan_;
   std::vector<float> lod_dt_s_;
   std::vector<float> lod_elapsed_s_, lod_phase_advance_, lod_tr_advance_;
+  // LOD: per slot, the gait cycles per second of its last plan's layers (gait_frequency; 0 without
+  // a gait clip), kept for the advance between plans; valid once planned with LOD on.
+  std::vector<float> lod_cycles_per_s_;
+  std::vector<uint8_t> lod_cycles_valid_;
+  bool lod_was_on_ = false;
   std::vector<glm::vec2> lod_root_at_plan_;
 };
 

@@ -67,14 +67,20 @@ inline bool sane_input(const glm::vec2& p, const glm::vec2& v, float theta) {
 }
 // The drawn root one step of dt [s] on: predicted from `root` with the filtered velocity and
 // pulled onto the simulator's p, never more than kMaxRootOffset from it.
+// The pull of pulled_root over a step dt [s] (one exp, shared by every agent stepped by dt).
+inline float root_pull(float dt) { return 1.0f - std::exp(-dt / kRootPullTime); }
 inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const glm::vec2& p,
-                             float dt) {
+                             float dt, float pull) {
   const glm::vec2 predicted = root + vel * dt;
-  glm::vec2 out = predicted + (p - predicted) * (1.0f - std::exp(-dt / kRootPullTime));
+  glm::vec2 out = predicted + (p - predicted) * pull;
   const glm::vec2 off = out - p;
   const float len = glm::length(off);
   if (len > kMaxRootOffset) out = p + off * (kMaxRootOffset / len);
   return out;
+}
+inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const glm::vec2& p,
+                             float dt) {
+  return pulled_root(root, vel, p, dt, root_pull(dt));
 }
 
 // A layer's clip time: a gait clip's at the shared gait phase, a standing clip's on its clock, a

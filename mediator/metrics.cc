@@ -62,7 +62,6 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
     if (slot_i < 0 || static_cast<size_t>(slot_i) >= capacity_) continue;
     const size_t slot = static_cast<size_t>(slot_i);
     if (!include.empty() && !include[slot]) continue;  // its track ends below
-    const std::span<const glm::mat4> w = poses.world(slot_i);
     Track& t = tracks_[slot];
     // A track holds consecutive frames of one agent; one that vanished and came back starts anew
     // (and a slot the mediator gave to a newcomer ends its former agent's track).
@@ -75,13 +74,13 @@ void MetricsRecorder::record(const AgentFrame& frame, const Mediator& m,
     }
     LimbFrame limbs;
     for (int s = 0; s < 2; ++s) {
-      limbs.joint[kToe][s] = translation_of(w[sk.toe(static_cast<Side>(s))]);
-      limbs.joint[kAnkle][s] = translation_of(w[sk.ankle(static_cast<Side>(s))]);
-      limbs.joint[kKnee][s] = translation_of(w[sk.knee(static_cast<Side>(s))]);
+      limbs.joint[kToe][s] = poses.joint_position(slot_i, sk.toe(static_cast<Side>(s)));
+      limbs.joint[kAnkle][s] = poses.joint_position(slot_i, sk.ankle(static_cast<Side>(s)));
+      limbs.joint[kKnee][s] = poses.joint_position(slot_i, sk.knee(static_cast<Side>(s)));
       for (int j = 0; j < kNumLimbJoints; ++j) non_finite_ += non_finite(limbs.joint[j][s]);
       slide_.add(2 * slot + s, limbs.joint[kToe][s], limbs.joint[kAnkle][s].y);
     }
-    const glm::vec3 pelvis = translation_of(w[hips]);
+    const glm::vec3 pelvis = poses.joint_position(slot_i, hips);
     non_finite_ += non_finite(pelvis);
     const glm::vec2 root(pelvis.x, pelvis.z);
     limbs.root = root;

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "animation/pose_jobs.h"
+#include "mediator/coarse_pose.h"
 #include "mediator/springs.h"
 
 namespace gk {
@@ -14,6 +15,8 @@ namespace gk {
 struct PoseSynthesizer::Scratch {
   std::vector<glm::quat> rot;    // 2 * kMaxBlendLayers * joints (a layer and its seam sample)
   std::vector<glm::vec3> trans;  // 2 * kMaxBlendLayers * joints
+  std::vector<glm::quat> coarse_rot;    // the coarse joints' blended pose (pose_coarse)
+  std::vector<glm::vec3> coarse_trans;
 };
 
 namespace {
@@ -111,6 +114,15 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
   return hi;
 }
 
+// A take (not a loop) replays one stride of itself: its last pose is not quite its first, so over
+// the stride's last fifth the pose one stride earlier is blended in with this weight, and the wrap
+// to the stride's start joins exactly.
+float take_seam(const LocomotionClip& lc, float time) {
+  if (!lc.gait || lc.clip.loops || time < lc.cycle_s) return 0.0f;
+  const float u = (time - lc.phase_to_time[0]) / std::max(lc.cycle_s, 1e-4f);
+  return smoothstep01((u - 0.8f) / 0.2f);
+}
+
 }  // namespace
 
 float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward) {
@@ -154,19 +166,25 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   pelvis_heading_.assign(capacity, 0.0f);
   upper_heading_.assign(capacity, 0.0f);
   has_prev_.assign(capacity, 0);
+  prev_rot_valid_.assign(capacity, 0);
   drop_.assign(capacity, 0.0f);
   drop_rate_.assign(capacity, 0.0f);
   placed_xz_.assign(capacity, glm::vec2(0.0f));
+  root_offset_.assign(capacity, glm::vec2(0.0f));
   locks_.lock.assign(capacity * 2, FootLock());
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.heel_pitch.assign(capacity * 2, 0.0f);
   locks_.heel_pitch_rate.assign(capacity * 2, 0.0f);
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
-  scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J] {
+  coarse_ = make_coarse_rig(library);
+  const size_t K = static_cast<size_t>(coarse_.num_coarse);
+  scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J, K] {
     Scratch s;
     s.rot.resize(2 * kMaxBlendLayers * J);
     s.trans.resize(2 * kMaxBlendLayers * J);
+    s.coarse_rot.resize(K);
+    s.coarse_trans.resize(K);
     return s;
   });
   subtree_end_ = subtree_ends(skeleton_);
@@ -237,24 +255,13 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
   });
 }
 
-// An agent not posed this frame: its world joints, palette and foot positions move with the
-// root's ground translation since they were placed (one add per matrix; the facing and the pose
-// wait for the next update).
+// An agent not posed this frame: its world joints and palette stay where they were posed and are
+// drawn root_offset further on (the root's ground walk since; the facing and the pose wait for the
+// next update). Its toes as the foot locks know them move with it.
 void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
-  const glm::vec2 delta = pl.root_xz[slot] - placed_xz_[slot];
-  if (delta.x == 0.0f && delta.y == 0.0f) return;
-  placed_xz_[slot] = pl.root_xz[slot];
-  const size_t base = static_cast<size_t>(slot) * num_joints_;
-  for (int j = 0; j < num_joints_; ++j) {
-    world_[base + j][3].x += delta.x;
-    world_[base + j][3].z += delta.y;
-  }
-  if (make_palettes_) {
-    for (int j = 0; j < num_joints_; ++j) {
-      palette_[base + j][3].x += delta.x;
-      palette_[base + j][3].z += delta.y;
-    }
-  }
+  const glm::vec2 offset = pl.root_xz[slot] - placed_xz_[slot];
+  const glm::vec2 delta = offset - root_offset_[slot];
+  root_offset_[slot] = offset;
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     locks_.drawn_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
@@ -301,13 +308,21 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     drop_[slot] = 0.0f;  // nothing of the slot's previous agent carries over
     drop_rate_[slot] = 0.0f;
   }
+  if (detail == PoseDetail::kLight && coarse_.useful()) {
+    pose_coarse(pl, P, slot, s);
+    return;
+  }
 
   // This slot's pose arrays, most likely out of the caches since its last frame: fetched while
   // the clips are sampled.
   prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
   prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
   prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
-  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
+  // Far agents (kLight) keep no rotation history: max_rotation_change is for the pop metric, which
+  // measures agents near the camera, and the history is a cold read and write of J quaternions.
+  if (detail != PoseDetail::kLight) {
+    prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
+  }
 
   // Sample and blend the planned layers.
   PoseLayer layers[2 * kMaxBlendLayers];
@@ -323,11 +338,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     // A take (not a loop) replays one stride of itself: its last pose is not quite its first, so
     // over the stride's last fifth the pose one stride earlier is blended in, and the wrap to the
     // stride's start joins exactly.
-    float seam = 0.0f;
-    if (lc.gait && !lc.clip.loops && time >= lc.cycle_s) {
-      const float u = (time - lc.phase_to_time[0]) / std::max(lc.cycle_s, 1e-4f);
-      seam = smoothstep01((u - 0.8f) / 0.2f);
-    }
+    const float seam = take_seam(lc, time);
     layers[num_layers++] = {r, t, w * (1.0f - seam)};
     if (seam > 0.0f) {
       const float earlier = time - lc.cycle_s;
@@ -345,6 +356,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool locking = apm && P.foot_locking && detail == PoseDetail::kFull;
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   placed_xz_[slot] = pl.root_xz[slot];
+  root_offset_[slot] = glm::vec2(0.0f);
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   const bool twisting = apm && detail != PoseDetail::kLight;
   if (twisting && can_twist_) {
@@ -359,7 +371,15 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
   if (locking) lock_feet(pl, P, slot, root, dt);
+  finish_pose(slot, detail, locking);
+}
 
+// What every posed agent ends with: headings, the rotation change, the drawn toes, the foot locks
+// reset when off, and the skinning palette.
+void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking) {
+  const size_t J = num_joints_;
+  const size_t base = static_cast<size_t>(slot) * J;
+  const bool track_rotation = detail != PoseDetail::kLight;
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
@@ -368,7 +388,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
-  if (has_prev_[slot] && J > 1) {
+  if (track_rotation && prev_rot_valid_[slot] && has_prev_[slot] && J > 1) {
     // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
     // Joint 0 carries the root facing, not a local bend.
     change = 2.0f * std::acos(min_abs_dot({local_rot_.data() + base + 1, J - 1},
@@ -391,7 +411,8 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
     }
   }
-  std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
+  if (track_rotation) std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
+  prev_rot_valid_[slot] = track_rotation;
   has_prev_[slot] = 1;
   if (make_palettes_) {
     SkinningPaletteJob job;
@@ -402,6 +423,46 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     job.stream_out = stream_palettes_;
     job.run();
   }
+}
+
+// A far agent's pose (PoseDetail::kLight) on the coarse joints only (mediator/coarse_pose.h): the
+// detail joints follow their parents rigidly. No twist, no foot locks, as the full path at kLight.
+void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot,
+                                  Scratch& s) {
+  const size_t K = static_cast<size_t>(coarse_.num_coarse);
+  const size_t base = static_cast<size_t>(slot) * num_joints_;
+  prefetch_bytes(world_.data() + base, num_joints_ * sizeof(glm::mat4), true);
+  PoseLayer layers[2 * kMaxBlendLayers];
+  int num_layers = 0;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
+    if (w <= 0.0f) continue;
+    const int c = pl.layer_clip[slot * kMaxBlendLayers + k];
+    const LocomotionClip& lc = library_.clips[c];
+    const float time = pl.layer_time_s[slot * kMaxBlendLayers + k];
+    std::span<glm::quat> r(s.rot.data() + num_layers * K, K);
+    std::span<glm::vec3> t(s.trans.data() + num_layers * K, K);
+    SampleClipJob{&coarse_.clips[c], time, r, t}.run();
+    const float seam = take_seam(lc, time);
+    layers[num_layers++] = {r, t, w * (1.0f - seam)};
+    if (seam > 0.0f) {
+      std::span<glm::quat> r2(s.rot.data() + num_layers * K, K);
+      std::span<glm::vec3> t2(s.trans.data() + num_layers * K, K);
+      SampleClipJob{&coarse_.clips[c], time - lc.cycle_s, r2, t2}.run();
+      layers[num_layers++] = {r2, t2, w * seam};
+    }
+  }
+  const std::span<glm::quat> rot(s.coarse_rot.data(), K);
+  const std::span<glm::vec3> trans(s.coarse_trans.data(), K);
+  BlendPosesJob{{layers, static_cast<size_t>(num_layers)}, rot, trans}.run();
+  glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
+  placed_xz_[slot] = pl.root_xz[slot];
+  root_offset_[slot] = glm::vec2(0.0f);
+  const bool apm = P.mode == MediatorMode::kApm;
+  if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
+  coarse_to_world(coarse_, skeleton_, rot, trans, root,
+                  {world_.data() + base, static_cast<size_t>(num_joints_)});
+  finish_pose(slot, PoseDetail::kLight, /*locking=*/false);
 }
 
 void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {

@@ -14,6 +14,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "mediator/animation_plans.h"
+#include "mediator/coarse_pose.h"
 #include "mediator/foot_lock.h"
 #include "mediator/locomotion_library.h"
 #include "mediator/params.h"
@@ -24,8 +25,8 @@ namespace gk {
 enum class PoseDetail : uint8_t {
   kFull = 0,         // everything: spine twist, foot locks and leg IK
   kNoFootLocks = 1,  // spine twist, no foot locks (they start afresh from the drawn toes)
-  kLight = 2,        // no spine twist, no foot locks
-  kHold = 3,         // not posed: the last pose moves with the root (root_xz) to where it is now
+  kLight = 2,        // no spine twist, no foot locks, coarse joints only (mediator/coarse_pose.h)
+  kHold = 3,         // not posed: the last pose is drawn where the root (root_xz) is now
 };
 
 // Per foot [slot * 2 + side].
@@ -51,12 +52,26 @@ class PoseSynthesizer {
            float dt_s, std::span<const uint8_t> detail_by_slot);
 
   int num_joints() const { return num_joints_; }
-  // World transforms of one slot's joints, as rendered.
+  // World transforms of one slot's joints where they were last posed. A slot held this frame
+  // (PoseDetail::kHold) is drawn root_offset(slot) further on: add it to the translations (or use
+  // joint_position), as the renderer does per instance.
   std::span<const glm::mat4> world(int slot) const {
     return {world_.data() + static_cast<size_t>(slot) * num_joints_,
             static_cast<size_t>(num_joints_)};
   }
-  // Every slot's skinning palette, slot after slot (empty without make_palettes).
+  // Ground displacement (x, z) [m] from where a slot's world joints and palette were posed to where
+  // it is drawn now: (0, 0) for a slot posed this frame; for a held one, its root's walk since its
+  // last pose. A held agent costs O(1) this way, not a move of every joint's matrix.
+  glm::vec2 root_offset(int slot) const { return root_offset_[slot]; }
+  std::span<const glm::vec2> root_offsets() const { return root_offset_; }
+  // One joint's world position as drawn this frame (world(slot)'s translation + root_offset).
+  glm::vec3 joint_position(int slot, int joint) const {
+    const glm::vec4& t = world_[static_cast<size_t>(slot) * num_joints_ + joint][3];
+    const glm::vec2 o = root_offset_[slot];
+    return {t.x + o.x, t.y, t.z + o.y};
+  }
+  // Every slot's skinning palette, slot after slot (empty without make_palettes); drawn with
+  // root_offset added to their translations, like world().
   std::span<const glm::mat4> palettes() const { return palette_; }
   std::span<const glm::mat4> palette(int slot) const {
     return {palette_.data() + static_cast<size_t>(slot) * num_joints_,
@@ -67,7 +82,7 @@ class PoseSynthesizer {
             static_cast<size_t>(num_joints_)};
   }
   // Largest change of any joint's local rotation since the slot's previous frame [rad] (0 on an
-  // agent's first frame).
+  // agent's first frame, and on a frame posed PoseDetail::kLight or right after one).
   float max_rotation_change(int slot) const { return rot_change_[slot]; }
   const FootLocks& foot_locks() const { return locks_; }
   // Final torsion pelvis -> chest [rad], signed, per slot.
@@ -82,6 +97,8 @@ class PoseSynthesizer {
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
+  void pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot, Scratch& s);
+  void finish_pose(int slot, PoseDetail detail, bool locking);
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
   void fk(int slot, int from, int to, const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
@@ -111,9 +128,11 @@ class PoseSynthesizer {
   std::vector<float> pelvis_heading_;
   std::vector<float> upper_heading_;
   std::vector<uint8_t> has_prev_;
+  std::vector<uint8_t> prev_rot_valid_;  // prev_local_rot_ holds the slot's last posed rotations
   std::vector<float> drop_;       // pelvis drop per slot [m]
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
+  std::vector<glm::vec2> root_offset_;  // root_offset(slot)
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   std::vector<int> subtree_end_;  // subtree_ends(skeleton_)
@@ -127,6 +146,7 @@ class PoseSynthesizer {
   bool can_twist_ = false;
   JointRange twist_range_;
   std::vector<int16_t> pre_twist_joints_;
+  CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
 };

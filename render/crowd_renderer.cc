@@ -218,7 +218,7 @@ int CrowdRenderer::cull_and_group(const OrbitCamera& camera, glm::ivec2 viewport
     const auto base =
         static_cast<uint32_t>(palette_block(a, static_cast<size_t>(i)) * joints_per_agent_);
     instances_[bucket_first_[a.mesh * kMaxMeshLods + visible_lod_[v]]++] = {
-        a.tint, base, glm::vec4(a.position, shadow)};
+        a.tint, base, glm::vec4(a.position, shadow), glm::vec4(a.offset, 0.0f)};
   }
   for (size_t b = 0; b < bucket_first_.size(); ++b) bucket_first_[b] -= bucket_count_[b];
   return num_visible;
@@ -336,6 +336,8 @@ void CrowdRenderer::draw_agents() {
                           reinterpret_cast<void*>(base + offsetof(GpuInstance, tint)));
     glVertexAttribIPointer(6, 1, GL_UNSIGNED_INT, sizeof(GpuInstance),
                            reinterpret_cast<void*>(base + offsetof(GpuInstance, palette_base)));
+    glVertexAttribPointer(8, 3, GL_FLOAT, GL_FALSE, sizeof(GpuInstance),
+                          reinterpret_cast<void*>(base + offsetof(GpuInstance, offset)));
     glUniform1f(lod_inflate_uniform_, m.lod_inflate_m[level]);
     const size_t first_byte = static_cast<size_t>(m.lod_first[level]) * sizeof(uint32_t);
     glDrawElementsInstanced(GL_TRIANGLES, m.lod_count[level], GL_UNSIGNED_INT,

@@ -38,6 +38,10 @@ struct AgentDraw {
   // Palette block of this agent [Limit: < blocks uploaded]; negative (the default): block i for
   // agent i of draw(), for palettes uploaded in draw order.
   int palette = -1;
+  // Added to the translation of every matrix of its palette block [m]: a pose made at one place
+  // drawn at another (a crowd's level of detail holds far agents' poses and moves them with their
+  // roots this way, one vector per agent instead of a rewrite of its palette).
+  glm::vec3 offset{0.0f};
 };
 
 // An upright box standing on or above the ground (exhibits, props): lit like the walls.
@@ -174,6 +178,7 @@ class CrowdRenderer {
     glm::vec3 tint;
     uint32_t palette_base;  // first matrix of this agent in the palette buffer
     glm::vec4 ground;       // xyz: ground point [m], w: shadow radius [m]
+    glm::vec4 offset;       // xyz: AgentDraw::offset [m], w: unused
   };
   struct LineVertex {  // matches lines.vert; lines have alpha 1
     glm::vec3 position;

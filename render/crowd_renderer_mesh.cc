@@ -153,6 +153,8 @@ Result<int> CrowdRenderer::add_mesh(const SkinnedMesh& mesh, const MeshLodOption
   glVertexAttribDivisor(5, 1);
   glEnableVertexAttribArray(6);
   glVertexAttribDivisor(6, 1);
+  glEnableVertexAttribArray(8);
+  glVertexAttribDivisor(8, 1);
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 

@@ -1,5 +1,6 @@
 // Instanced linear blend skinning. Every agent's palette lives in one texture buffer (4 RGBA32F
-// texels per column-major mat4); the instance attribute says where this agent's palette starts.
+// texels per column-major mat4); the instance attributes say where this agent's palette starts and
+// how far from where it was posed the agent is drawn (a held pose of the crowd's level of detail).
 
 uniform samplerBuffer u_palette;  // texture unit 0
 // A lighter mesh level is pushed out along the bind-pose normals by this much [m], so that it
@@ -13,6 +14,7 @@ layout(location = 3) in uvec4 a_joints;
 layout(location = 4) in vec4 a_weights;
 layout(location = 5) in vec3 i_tint;
 layout(location = 6) in uint i_palette_base;
+layout(location = 8) in vec3 i_offset;  // added to every palette translation [m]
 
 out vec3 v_world_pos;
 out vec3 v_normal;
@@ -27,7 +29,9 @@ mat4 palette_matrix(uint joint) {
 void main() {
   mat4 skin = a_weights.x * palette_matrix(a_joints.x) + a_weights.y * palette_matrix(a_joints.y) +
               a_weights.z * palette_matrix(a_joints.z) + a_weights.w * palette_matrix(a_joints.w);
+  // The weights sum to 1, so adding the offset once equals adding it to each palette matrix.
   vec4 world = skin * vec4(a_position + a_normal * u_lod_inflate_m, 1.0);
+  world.xyz += i_offset * world.w;
   v_world_pos = world.xyz;
   // Palettes are rigid (or uniformly scaled) per joint, so the blended upper 3x3 is a good enough
   // normal matrix; the fragment shader renormalises.

@@ -16,6 +16,7 @@
 #include "tests/mediator/mediator_fixture.h"
 #include "tests/mediator/scripted_crowd.h"
 #include "tests/pipeline/allocation_counter.h"
+#include "tests/test_data.h"
 
 namespace gk {
 namespace {
@@ -101,7 +102,8 @@ TEST(LodPolicy, AgentsOfALevelAreSpreadEvenlyOverItsPeriod) {
     for (int level = 0; level < kNumLodLevels; ++level) {
       EXPECT_EQ(policy.counts()[level], 250);
       // 250 agents over a period of P frames: 250 / P each frame, give or take one.
-      EXPECT_NEAR(due[level], 250.0 / kLodPeriod[level], 1.0) << "level " << level << " frame " << f;
+      EXPECT_NEAR(due[level], 250.0 / kLodPeriod[level], 1.0)
+          << "level " << level << " frame " << f;
     }
   }
   // Over 8 frames every agent is updated exactly 8 / period times.
@@ -178,7 +180,9 @@ TEST(CrowdPipelineLod, DistantAgentsPhaseAdvancesAndRootFollowsBetweenUpdates) {
   int held = 0;
   for (int f = 0; f < 120; ++f) {
     const float phase_before = pipeline.plans().phase[0];
-    const glm::vec3 hips_before = translation_of(pipeline.poses().world(0)[hips]);
+    const glm::vec3 hips_before = pipeline.poses().joint_position(0, hips);
+    const std::vector<glm::mat4> world_before(pipeline.poses().world(0).begin(),
+                                              pipeline.poses().world(0).end());
     const glm::vec2 root_before = pipeline.plans().root_xz[0];
     ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
     ASSERT_EQ(pipeline.lod().level(0), 3);
@@ -192,42 +196,52 @@ TEST(CrowdPipelineLod, DistantAgentsPhaseAdvancesAndRootFollowsBetweenUpdates) {
     EXPECT_LT(glm::length(pl.root_xz[0] - pipeline.frame().positions[0]), 0.061f);
     if (!pipeline.lod().due()[0]) {
       ++held;
-      // The held body moves exactly with the root.
-      const glm::vec3 moved = translation_of(pipeline.poses().world(0)[hips]) - hips_before;
+      // The held body is drawn moved exactly with the root, by its root offset alone: the posed
+      // joints are not rewritten (a held agent costs O(1)).
+      const auto world = pipeline.poses().world(0);
+      EXPECT_TRUE(std::equal(world.begin(), world.end(), world_before.begin()));
+      const glm::vec3 moved = pipeline.poses().joint_position(0, hips) - hips_before;
       const glm::vec2 root_moved = pl.root_xz[0] - root_before;
       EXPECT_NEAR(moved.x, root_moved.x, 1e-4f);
       EXPECT_NEAR(moved.z, root_moved.y, 1e-4f);
       EXPECT_NEAR(moved.y, 0.0f, 1e-6f);
       EXPECT_GT(glm::length(root_moved), 0.5f * 1.3f * kDt);
+    } else {
+      EXPECT_EQ(pipeline.poses().root_offset(0), glm::vec2(0.0f));  // posed where it is
     }
   }
   EXPECT_EQ(held, 120 - 120 / 8);
 }
 
 // The largest distance any joint moves from one frame to the next [m].
-float max_joint_step(std::span<const glm::mat4> a, std::span<const glm::mat4> b) {
+float max_joint_step(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
   float d = 0.0f;
-  for (size_t j = 0; j < a.size(); ++j) {
-    d = std::max(d, glm::length(translation_of(a[j]) - translation_of(b[j])));
-  }
+  for (size_t j = 0; j < a.size(); ++j) d = std::max(d, glm::length(a[j] - b[j]));
   return d;
+}
+
+// A slot's joints as drawn this frame (held poses moved on by their root offset).
+std::vector<glm::vec3> drawn_joints(const PoseSynthesizer& poses, int slot) {
+  std::vector<glm::vec3> out(poses.num_joints());
+  for (int j = 0; j < poses.num_joints(); ++j) out[j] = poses.joint_position(slot, j);
+  return out;
 }
 
 // A walker coming from far away to the focus and on past it crosses every level boundary twice.
 // Without LOD, its largest joint step from one frame to the next (a swinging foot) is one frame of
 // its motion, M, itself within what a walk at speed s allows (kLimbSpeedFactor * s +
 // kLimbSpeedMargin per second). With LOD no joint may move from one frame to the next by more than
-// the frames since the agent's last update times M (to 10%), plus kLevelChangeSlack at a level change (the
-// foot locks' last IK offsets, at most a few cm, are let go when the agent leaves level 0).
-TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
+// the frames since the agent's last update times M (to 10%), plus kLevelChangeSlack at a level
+// change (the foot locks' last IK offsets, at most a few cm, are let go when the agent leaves level
+// 0).
+void expect_no_joint_jumps(const LocomotionLibrary& lib, bool check_level0_changes = true) {
   constexpr float kLimbSpeedFactor = 6.0f;
-  constexpr float kLimbSpeedMargin = 0.5f;  // [m/s]
+  constexpr float kLimbSpeedMargin = 0.5f;    // [m/s]
   constexpr float kLevelChangeSlack = 0.03f;  // [m]
   // The two runs' feet lock at slightly different moments (with LOD the locks start afresh on
   // entering level 0), so the largest step of one is the other's to within this factor.
   constexpr float kMotionMargin = 1.1f;
   const float speed = 1.4f;
-  const LocomotionLibrary& lib = test::builtin_library();
   float frame_motion = 0.0f;  // M [m]
   for (bool use_lod : {false, true}) {
     SCOPED_TRACE(use_lod ? "LOD" : "no LOD");
@@ -236,11 +250,11 @@ TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
     if (use_lod) {
       ASSERT_TRUE(pipeline.set_lod(lod_at({0.0f, 0.0f}, 8.0f, 16.0f, 28.0f)).ok());
     }
-    std::vector<glm::mat4> last;
+    std::vector<glm::vec3> last;
     int frames_since_update = 1, changes = 0, last_level = -1;
     for (int f = 0; f < 60 * 55; ++f) {
       ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
-      const auto world = pipeline.poses().world(0);
+      const std::vector<glm::vec3> world = drawn_joints(pipeline.poses(), 0);
       const int level = pipeline.lod().level(0);
       const bool changed = last_level >= 0 && level != last_level;
       // The first second is the walker's start (it is fresh, standing, then walking).
@@ -249,17 +263,27 @@ TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
         if (!use_lod) {
           frame_motion = std::max(frame_motion, step);
         } else {
-          const float bound = static_cast<float>(frames_since_update) * kMotionMargin * frame_motion +
-                              (changed ? kLevelChangeSlack : 0.0f);
-          ASSERT_LE(step, bound) << "frame " << f << " level " << level << " (was " << last_level
-                                 << ", " << frames_since_update << " frames since the last update)";
+          const float bound =
+              static_cast<float>(frames_since_update) * kMotionMargin * frame_motion +
+              (changed ? kLevelChangeSlack : 0.0f);
+          size_t worst = 0;
+          for (size_t j = 0; j < world.size(); ++j) {
+            if (glm::length(world[j] - last[j]) > glm::length(world[worst] - last[worst]))
+              worst = j;
+          }
+          const bool level0_change = changed && std::min(level, last_level) == 0;
+          if (!level0_change || check_level0_changes) {
+            ASSERT_LE(step, bound) << "joint " << lib.skeleton->names[worst] << " frame " << f
+                                   << " level " << level << " (was " << last_level << ", "
+                                   << frames_since_update << " frames since the last update)";
+          }
         }
       }
       changes += changed && f > 1;  // frame 1: the newcomer takes its level
       last_level = level;
       const bool updated = !use_lod || pipeline.lod().due()[0];
       frames_since_update = updated ? 1 : frames_since_update + 1;
-      last.assign(world.begin(), world.end());
+      last = world;
     }
     if (!use_lod) {
       EXPECT_GT(frame_motion, speed * kDt);
@@ -268,6 +292,22 @@ TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
       EXPECT_EQ(changes, 6);  // 3 -> 2 -> 1 -> 0 -> 1 -> 2 -> 3
     }
   }
+}
+
+TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumps) {
+  expect_no_joint_jumps(test::builtin_library());
+}
+
+// The same with the 53-joint mannequin, whose fingers and toes levels 2 and 3 leave out (they
+// follow their parents in the standing pose there): entering and leaving those levels moves them
+// no more than the slack. Open, not checked here: leaving level 0, the mannequin's foot locks can
+// let go of more than the slack at once (a foot about 8 cm beyond it, as before the coarse
+// joints: levels 0 and 1 pose every joint).
+TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumpsWithCoarseJoints) {
+  GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
+  auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  expect_no_joint_jumps(*lib, /*check_level0_changes=*/false);
 }
 
 // Per-frame code allocates nothing, with LOD too (walkers over every level, metrics on).

@@ -287,6 +287,48 @@ TEST_F(RendererTest, SkinningRotatesSecondJoint) {
   EXPECT_GT(c.x, c.z + 40) << int(c.x) << "," << int(c.y) << "," << int(c.z);
 }
 
+// An agent's offset moves its whole palette block: a pose made at one place and drawn with the
+// offset to another looks as the same pose made there (a held pose of the crowd's level of detail).
+TEST_F(RendererTest, OffsetDrawsThePaletteWhereTheAgentIsNow) {
+  Result<int> mesh = renderer_->add_mesh(make_two_bone_column());
+  ASSERT_TRUE(mesh.ok()) << mesh.message();
+  camera_.target = glm::vec3(0.0f, 1.0f, 0.0f);
+  camera_.pitch_rad = 0.1f;
+  camera_.distance_m = 8.0f;
+  const glm::vec3 posed_at(-1.5f, 0.0f, 0.0f), now_at(1.5f, 0.0f, 0.5f);
+  std::vector<glm::mat4> there(2), here(2);
+  column_palette(posed_at, kPi / 4.0f, there);
+  column_palette(now_at, kPi / 4.0f, here);
+
+  FrameCapture empty, moved, made_here;
+  ASSERT_NO_FATAL_FAILURE(render({}, &empty));
+  AgentDraw agent{now_at, glm::vec3(1.0f), *mesh};
+  agent.offset = now_at - posed_at;
+  ASSERT_TRUE(renderer_->upload_palettes(there, 2).ok());
+  ASSERT_NO_FATAL_FAILURE(render(std::span(&agent, 1), &moved));
+  agent.offset = glm::vec3(0.0f);
+  ASSERT_TRUE(renderer_->upload_palettes(here, 2).ok());
+  ASSERT_NO_FATAL_FAILURE(render(std::span(&agent, 1), &made_here));
+
+  auto at = [&](const FrameCapture& f, const glm::vec3& p) {
+    const ProjectedPoint q = camera_.project(p, viewport());
+    return f.pixel(static_cast<int>(q.pixel.x), static_cast<int>(q.pixel.y));
+  };
+  // Nothing is left where the pose was made; the body stands where the agent is (the point is in
+  // the bent, orange upper box).
+  const glm::vec3 body(-0.35f, 1.35f, 0.0f);
+  EXPECT_EQ(at(moved, posed_at + body), at(empty, posed_at + body));
+  EXPECT_GT(pixel_difference(at(moved, now_at + body), at(empty, now_at + body)), 30);
+  // And the two images agree but for rounding at a few edge pixels.
+  int differing = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      differing += pixel_difference(moved.pixel(x, y), made_here.pixel(x, y)) > 30;
+    }
+  }
+  EXPECT_LT(differing, kWidth * kHeight / 2000) << differing << " pixels differ";
+}
+
 TEST_F(RendererTest, OneInstancedDrawPerMeshAndPerAgentTint) {
   Result<int> a = renderer_->add_mesh(make_two_bone_column(0.4f));
   Result<int> b = renderer_->add_mesh(make_two_bone_column(0.6f));
