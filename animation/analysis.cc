@@ -339,14 +339,13 @@ float path_speed(const std::vector<glm::vec3>& root, float fps) {
 // "Still" is relative to the clip's own travel speed (a planted point moves slower than half the
 // body's speed; a swing foot moves about twice it); "low" is relative to the point's own lowest
 // heights over the fitted ground (a gate well below the swing's height, never the judge alone).
-// `floor`: per frame, the floor under this foot (stance_floor), or null for the fitted line.
+// `k`: frames on either side for velocities (velocity_half_window). `floor`: per frame, the floor
+// under this foot (stance_floor), or null for the fitted line.
 void detect_contacts(const Tracks& tr, int s, const Clip& clip, const ClipAnalysis& a,
-                     const glm::vec3& travel_vel, const ContactThresholds& th,
+                     const glm::vec3& travel_vel, const ContactThresholds& th, int k,
                      const std::vector<float>* floor, std::vector<uint8_t>* out) {
   const int n = static_cast<int>(tr.root.size());
-  const float still =
-      std::max(th.min_still_speed_m_s, th.still_fraction_of_travel * glm::length(travel_vel));
-  const int k = velocity_half_window(clip.fps, capture_jitter_m(tr), still);
+  const float still = still_speed_m_s(glm::length(travel_vel), th);
   out->assign(n, 0);
   const std::vector<glm::vec3>* joints[4] = {&tr.toe[s], &tr.ankle[s], &tr.heel[s], &tr.tip[s]};
   std::vector<uint8_t> down[4];
@@ -565,8 +564,11 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
   const glm::vec3 travel_vel = a.in_place ? in_place_travel(tr, clip) : root_vel;
   std::vector<uint8_t> contact[2];
   const int min_frames = std::max(2, static_cast<int>(std::lround(th.min_duration_s * clip.fps)));
+  // Velocities over the window the capture's jitter needs at this still speed (found once).
+  const int k = velocity_half_window(clip.fps, capture_jitter_m(tr),
+                                     still_speed_m_s(glm::length(travel_vel), th));
   for (int s = 0; s < 2; ++s) {
-    detect_contacts(tr, s, clip, a, travel_vel, th, nullptr, &contact[s]);
+    detect_contacts(tr, s, clip, a, travel_vel, th, k, nullptr, &contact[s]);
     filter_runs(contact[s], min_frames, clip.loops);
   }
   // A take's floor may tilt or drift: heights again, over the floor of each stance just found
@@ -576,7 +578,7 @@ ClipAnalysis analyze_clip(const Clip& clip, const Skeleton& sk, const ContactThr
     for (int s = 0; s < 2; ++s) {
       const std::vector<float> floor = stance_floor(tr.toe[s], contact[s], drift, clip.fps);
       if (floor.empty()) continue;
-      detect_contacts(tr, s, clip, a, travel_vel, th, &floor, &contact[s]);
+      detect_contacts(tr, s, clip, a, travel_vel, th, k, &floor, &contact[s]);
       filter_runs(contact[s], min_frames, clip.loops);
     }
   }

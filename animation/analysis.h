@@ -2,6 +2,7 @@
 // Clip analysis, done once at load: native speed and travel direction, foot contacts, the gait
 // cycle and a normalised gait phase, and the foot-slide floor of ../shared/docs/METRICS.md.
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,12 @@ struct ContactThresholds {
   float min_height_gate_m = 0.02f;        // [m] of its lowest heights, and at least this
   float min_duration_s = 0.04f;           // [s] shorter contacts and gaps are jitter: dropped
 };
+
+// The speed over the ground below which a point counts as still [m/s], for a body travelling at
+// travel_m_s: the larger of its share of the travel and the jitter floor.
+inline float still_speed_m_s(float travel_m_s, const ContactThresholds& th = {}) {
+  return std::max(th.min_still_speed_m_s, th.still_fraction_of_travel * travel_m_s);
+}
 
 struct SlideStats {
   float mean_cm_s = 0.0f;

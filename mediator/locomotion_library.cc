@@ -254,8 +254,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     // trimmed to where the ball rests. (Clips authored in place are judged by the direction their
     // stance foot is carried, not its speed over the ground, which keyframes need not keep.)
     if (!lc->analysis.in_place) {
-      const float rest = std::max(ContactThresholds{}.min_still_speed_m_s,
-                                  ContactThresholds{}.still_fraction_of_travel * glm::length(travel));
+      const float rest = still_speed_m_s(glm::length(travel));
       std::vector<uint8_t>& pl = lc->plant[s];
       int first_free = -1;
       for (int f = 0; f < n && first_free < 0; ++f) {
@@ -478,8 +477,7 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
     lc.hold[s].assign(n, 0);
     std::vector<float> rested;
     for (int f = 0; f < n; ++f) {
-      const float rest =
-          std::max(ct.min_still_speed_m_s, ct.still_fraction_of_travel * (*speed)[f]);
+      const float rest = still_speed_m_s((*speed)[f], ct);
       lc.plant[s][f] = contact[f] && ground[f] <= rest;
       if (lc.plant[s][f]) rested.push_back(ground[f]);
     }
