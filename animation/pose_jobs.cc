@@ -92,24 +92,6 @@ void weighted_floats(const float* a, float wa, const float* b, float wb, size_t 
   for (; i < n; ++i) out[i] = a[i] * wa + b[i] * wb;
 }
 
-// Rotation taking unit vector `from` onto unit vector `to` (identity when either is degenerate).
-glm::quat rotation_between(glm::vec3 from, glm::vec3 to) {
-  const float lf = glm::length(from), lt = glm::length(to);
-  if (lf < 1e-8f || lt < 1e-8f) return glm::quat(1, 0, 0, 0);
-  from /= lf;
-  to /= lt;
-  const float d = clamp_unit(glm::dot(from, to));
-  glm::vec3 axis = glm::cross(from, to);
-  const float axis_len = glm::length(axis);
-  if (axis_len < 1e-7f) {
-    if (d > 0.0f) return glm::quat(1, 0, 0, 0);
-    // Opposite vectors: any axis perpendicular to `from` will do.
-    axis = glm::cross(from, std::abs(from.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
-    return glm::angleAxis(glm::pi<float>(), glm::normalize(axis));
-  }
-  return glm::angleAxis(std::atan2(axis_len, d), axis / axis_len);
-}
-
 // Rotation by the angle whose cosine and sine are proportional to (c, s) (atan2(s, c), any common
 // positive scale) about the unit axis, without the angle: the half-angle quaternion is
 // proportional to (1 + cos, sin axis) = (r + c, s axis) / r. Exact in value; near half a turn
@@ -139,17 +121,23 @@ glm::quat rotation_by_acos_difference(float c1, float c0, const glm::vec3& axis)
   return glm::quat(cw, sw * axis.x, sw * axis.y, sw * axis.z);
 }
 
-// rotation_between without the angle: the half-way quaternion (1 + cos, from x to), normalised,
-// is the same rotation (see rotation_of_cos_sin).
-glm::quat rotation_between_fast(glm::vec3 from, glm::vec3 to) {
+// Rotation taking vector `from` onto vector `to` (identity when either is degenerate), without
+// the angle: the half-way quaternion (1 + cos, from x to), normalised (rotation_of_cos_sin, which
+// takes the angle only near half a turn).
+glm::quat rotation_between(glm::vec3 from, glm::vec3 to) {
   const float lf = glm::length(from), lt = glm::length(to);
   if (lf < 1e-8f || lt < 1e-8f) return glm::quat(1, 0, 0, 0);
   from /= lf;
   to /= lt;
   const float d = clamp_unit(glm::dot(from, to));
-  const glm::vec3 axis = glm::cross(from, to);
+  glm::vec3 axis = glm::cross(from, to);
   const float axis_len = glm::length(axis);
-  if (axis_len < 1e-7f || d < -0.999f) return rotation_between(from, to);
+  if (axis_len < 1e-7f) {
+    if (d > 0.0f) return glm::quat(1, 0, 0, 0);
+    // Opposite vectors: any axis perpendicular to `from` will do.
+    axis = glm::cross(from, std::abs(from.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
+    return glm::angleAxis(glm::pi<float>(), glm::normalize(axis));
+  }
   return rotation_of_cos_sin(d, axis_len, axis / axis_len);
 }
 
@@ -451,7 +439,7 @@ void TwoBoneIKJob::run() const {
   }
   // End joint after the bend, then swing the chain onto the target direction.
   const glm::vec3 c1 = a + r_bend * (b - a) + r_bend * (r_knee * (c - b));
-  const glm::quat r_swing = rotation_between_fast(c1 - a, target - a);
+  const glm::quat r_swing = rotation_between(c1 - a, target - a);
   glm::quat r = r_swing * r_bend;
 
   // Twist about the start-target axis so the knee points toward the pole.

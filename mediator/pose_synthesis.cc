@@ -73,9 +73,10 @@ float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle_floor)
 
 // The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
 // about the ball, as far as heel_room allows (bisection; the distance shrinks as the heel rises
-// toward the hip). Returns the pitch [rad].
+// toward the hip). Returns the pitch [rad]. `closed_form` off: every step measures the distance
+// (the reference the closed form is tested against).
 float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
-                     float limit) {
+                     float limit, bool closed_form = true) {
   const glm::vec3 d = ankle - toe;
   const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
   const float room = heel_room(d);
@@ -93,7 +94,7 @@ float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
   const float a_cos = 2.0f * glm::dot(e, d), b_sin = 2.0f * glm::dot(e, w);
   const float m = std::sqrt(a_cos * a_cos + b_sin * b_sin);
   const float c = m > 1e-6f ? (limit * limit - k) / m : 2.0f;
-  const bool analytic = std::abs(c) < 1.0f - 1e-3f;
+  const bool analytic = closed_form && std::abs(c) < 1.0f - 1e-3f;
   const float phi = analytic ? std::atan2(b_sin, a_cos) : 0.0f;
   const float half_width = analytic ? std::acos(c) : 0.0f;
   auto beyond = [&](float a) {
@@ -229,13 +230,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
 PoseSynthesizer::~PoseSynthesizer() = default;
 
 void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorParams& P, float dt_s) {
-  tbb::enumerable_thread_specific<Scratch>& scratch = *scratch_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 32), [&](const tbb::blocked_range<size_t>& r) {
-    Scratch& s = scratch.local();
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      synthesize_agent(pl, P, pl.slot_of_agent[i], dt_s, s);
-    }
-  });
+  run(pl, n, P, dt_s, {});
 }
 
 void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorParams& P, float dt_s,
@@ -245,7 +240,7 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
     Scratch& s = scratch.local();
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const int slot = pl.slot_of_agent[i];
-      const auto d = static_cast<PoseDetail>(detail[slot]);
+      const auto d = detail.empty() ? PoseDetail::kFull : static_cast<PoseDetail>(detail[slot]);
       if (d == PoseDetail::kHold && !pl.fresh[slot]) {
         hold_agent(pl, slot);
       } else {
@@ -524,9 +519,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     in.other_landing = pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&
                        other != FootLockState::kStepping && other_coming_down;
     in.floor_toe_m = library_.planted_toe_m[side];
-    in.still_speed_m_s =
-        std::max(ContactThresholds{}.min_still_speed_m_s,
-                 ContactThresholds{}.still_fraction_of_travel * pl.speed_m_s[slot]);
+    in.still_speed_m_s = still_speed_m_s(pl.speed_m_s[slot]);
     const FootLockStep next = step_foot_lock(locks_.lock[k], in, lp, dt);
     locks_.lock[k] = next.state;
     goal[side] = next.goal;
@@ -681,23 +674,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
 }
 
 float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
-                     float limit) {
-  return heel_off_pivot(toe, ankle, hip, limit);
-}
-
-float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
-                               float limit) {
-  const glm::vec3 d = ankle - toe;
-  const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
-  const float room = heel_room(d);
-  auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
-  if (dist(room) > limit) return room;
-  float lo = 0.0f, hi = room;
-  for (int i = 0; i < 12; ++i) {
-    const float mid = 0.5f * (lo + hi);
-    (dist(mid) > limit ? lo : hi) = mid;
-  }
-  return hi;
+                     float limit, bool closed_form) {
+  return heel_off_pivot(toe, ankle, hip, limit, closed_form);
 }
 
 }  // namespace gk

@@ -47,7 +47,8 @@ class PoseSynthesizer {
   // plans.slot_of_agent[i]) with the parameters they were planned with.
   void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
            float dt_s);
-  // The same with a PoseDetail per slot (`detail_by_slot`, as uint8_t; capacity long).
+  // The same with a PoseDetail per slot (`detail_by_slot`, as uint8_t; capacity long, or empty:
+  // every agent in full).
   void run(const AnimationPlans& plans, size_t num_agents, const MediatorParams& params,
            float dt_s, std::span<const uint8_t> detail_by_slot);
 
@@ -155,12 +156,10 @@ class PoseSynthesizer {
 // ankle within `limit` [m] of the hip: the heel rises about the ball, as far as the foot may pitch
 // up (at most to about 57 deg of the toe -> ankle line; all of that when even it is not enough).
 // Found by 12 bisection steps over that range (the distance shrinks as the heel rises toward the
-// hip), most of them decided by the distance's closed form.
+// hip), most of them decided by the distance's closed form; with `closed_form` off, every step
+// measures the distance (the reference).
 float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
-                     float limit);
-// The same bisection measuring the distance at every step (the reference of heel_off_pitch).
-float heel_off_pivot_bisection(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
-                               float limit);
+                     float limit, bool closed_form = true);
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
 // +z; rest_forward is that +z in the joint's own frame): heading [rad].

@@ -30,7 +30,7 @@ TEST(HeelOffPivot, SameStepsAsTheMeasuredBisection) {
     const float reach = glm::length(ankle - hip);
     const float limit = reach * (0.85f + 0.2f * u01(rng));
     const float fast = heel_off_pitch(toe, ankle, hip, limit);
-    const float reference = heel_off_pivot_bisection(toe, ankle, hip, limit);
+    const float reference = heel_off_pitch(toe, ankle, hip, limit, /*closed_form=*/false);
     ASSERT_EQ(fast, reference) << "trial " << trial;
     if (fast > 0.0f) ++pivoted;
     // Short of the whole range (the toe -> ankle line at 1 rad), the pitched ankle is within the
