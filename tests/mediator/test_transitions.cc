@@ -119,38 +119,37 @@ TEST(Transitions, TheBuiltinLibraryHasNone) {
   for (const LocomotionClip& c : test::builtin_library().clips) EXPECT_FALSE(c.transition);
 }
 
-TEST(Transitions, AnAgentStartingFromRestPlaysTheStartClip) {
-  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh");
-  auto lib = start_stop_library();
-  ASSERT_TRUE(lib.ok()) << lib.message();
-  const Played p = play(*lib, starting, 300);
-  EXPECT_EQ(p.counts[kStartsSeen], 1u);
-  EXPECT_EQ(p.counts[kStartsPlayed], 1u);
-  EXPECT_EQ(p.counts[kStopsSeen], 0u);
-  EXPECT_GT(p.frames_with[0], 20);
-  EXPECT_FLOAT_EQ(p.max_weight[0], 1.0f);
-  EXPECT_EQ(p.frames_with[1], 0);
+// One transition of `kind` (0 start, 1 stop) was seen and played, for more than 20 frames and up to
+// full weight, and none of the other kind; the motion stayed within the bounds.
+constexpr int kStart = 0, kStop = 1;
+void expect_one_played(const Played& p, int kind) {
+  const int seen = kind == kStart ? kStartsSeen : kStopsSeen;
+  const int played = kind == kStart ? kStartsPlayed : kStopsPlayed;
+  const int other_seen = kind == kStart ? kStopsSeen : kStartsSeen;
+  EXPECT_EQ(p.counts[seen], 1u);
+  EXPECT_EQ(p.counts[played], 1u);
+  EXPECT_EQ(p.counts[other_seen], 0u);
+  EXPECT_GT(p.frames_with[kind], 20);
+  EXPECT_FLOAT_EQ(p.max_weight[kind], 1.0f);
+  EXPECT_EQ(p.frames_with[1 - kind], 0);
   EXPECT_LE(p.report.root_error_cm.mean, 3.0);
   EXPECT_LE(p.report.feet.support_slide_cm_s, 2.0);
   EXPECT_EQ(p.report.playback_outside_limits, 0.0);
   EXPECT_EQ(p.pops, 0);
 }
 
+TEST(Transitions, AnAgentStartingFromRestPlaysTheStartClip) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  expect_one_played(play(*lib, starting, 300), kStart);
+}
+
 TEST(Transitions, AnAgentComingToRestPlaysTheStopClip) {
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
   auto lib = start_stop_library();
   ASSERT_TRUE(lib.ok()) << lib.message();
-  const Played p = play(*lib, stopping, 300);
-  EXPECT_EQ(p.counts[kStopsSeen], 1u);
-  EXPECT_EQ(p.counts[kStopsPlayed], 1u);
-  EXPECT_EQ(p.counts[kStartsSeen], 0u);
-  EXPECT_GT(p.frames_with[1], 20);
-  EXPECT_FLOAT_EQ(p.max_weight[1], 1.0f);
-  EXPECT_EQ(p.frames_with[0], 0);
-  EXPECT_LE(p.report.root_error_cm.mean, 3.0);
-  EXPECT_LE(p.report.feet.support_slide_cm_s, 2.0);
-  EXPECT_EQ(p.report.playback_outside_limits, 0.0);
-  EXPECT_EQ(p.pops, 0);
+  expect_one_played(play(*lib, stopping, 300), kStop);
 }
 
 // The same library with its transitions taken away: starts and stops are counted, none is played,
