@@ -11,6 +11,9 @@
 namespace gk {
 
 inline constexpr int kMaxBlendLayers = 4;
+// From this share of gait clips (and transitions) in the blend on, they vote the foot flags (plant,
+// hold, swing) and the feet walk; below it the standing clip's flags hold both feet down.
+inline constexpr float kGaitVoteWeight = 0.25f;
 
 // Per-slot plan for one frame, read by the pose synthesis pass and the metrics.
 struct AnimationPlans {

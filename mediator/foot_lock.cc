@@ -67,9 +67,10 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
         return release_foot_lock(pinned, pinned.target + pinned.offset, glm::vec3(0.0f),
                                  in.anim_toe, anim_vel);
       }
-      // A foot left behind by a turn or a drift re-plants with a short step, one foot at a time.
+      // A foot left behind by a turn or a drift while the clips stand re-plants with a short step,
+      // one foot at a time (walking, its own swing comes and takes the offset).
       const float drift = std::hypot(s.target.x - in.anim_toe.x, s.target.z - in.anim_toe.z);
-      if (drift > p.step_distance_m && in.other_locked) {
+      if (drift > p.step_distance_m && in.other_locked && !in.walking) {
         return start_foot_step(pinned, pinned.target + pinned.offset);
       }
       return s;

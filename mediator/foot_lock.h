@@ -16,6 +16,7 @@
 //   kReleasing -> kLocked     plant_foot: planted again before the offset was shed
 //   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing)
 //   kLocked    -> kStepping   start_foot_step: left too far behind while the other foot is pinned
+//                             and the clips are not walking (their own swing re-places it)
 //   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done
 //   kStepping  -> kLocked     the step has landed: pinned at the clip's toe
 //   kReleasing -> kFree       the offset is shed
@@ -59,6 +60,10 @@ struct FootLockInput {
   bool hold = false;               // the clips still have weight on it (a lock is kept)
   float swing_progress = 0.0f;     // the clips' swing of this foot, 0 at lift-off, 1 at landing
   bool other_locked = false;       // the other foot is pinned (one foot steps at a time)
+  // The gait clips are walking (they vote the feet): this foot's own swing comes soon and carries
+  // it back to the clip's foot, so a drift alone starts no re-planting step (a step would lift it
+  // while the other foot may still be rolling down onto its ball: both off the ground).
+  bool walking = false;
   // Walking, the other foot is coming down or planted but not pinned yet: this one keeps its
   // weight (its lock) until the other has taken it over, as a trailing foot stays down until the
   // leading one is flat. (Running has a flight phase: no such wait.)

@@ -552,7 +552,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       if (lib.clips[lc[k]].transition) moving_w += lw[k];
     }
-    const bool gait_votes = moving_w >= 0.25f;
+    const bool gait_votes = moving_w >= kGaitVoteWeight;
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       const LocomotionClip& clip = lib.clips[lc[k]];
       lt[k] = layer_time(clip, phase[slot], idle_time_s[slot], transition_time_s[slot]);

@@ -514,6 +514,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     in.swing_progress = pl.swing_progress[side][slot];
     const FootLockState other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
     in.other_locked = other == FootLockState::kLocked;
+    in.walking = pl.gait_weight[slot] >= kGaitVoteWeight;
     const bool other_coming_down =
         pl.plant[1 - side][slot] >= 0.5f || pl.swing_progress[1 - side][slot] >= 0.5f;
     in.other_landing = pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&

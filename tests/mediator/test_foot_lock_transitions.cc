@@ -287,6 +287,18 @@ TEST(FootLockTransition, PinnedFootLeftBehindStepsFromItsPinAndReplantsAtTheClip
   // Without the other foot pinned it stays (one foot steps at a time).
   in.other_locked = false;
   EXPECT_EQ(step_foot_lock(s, in, p, kDt).state.state, FootLockState::kLocked);
+  // Nor while the clips walk: their own swing of this foot comes and takes the offset, so it
+  // stays pinned where it is (however far the clip's toe has drifted) and no step lifts it.
+  in.other_locked = true;
+  in.walking = true;
+  for (const float away : {0.3f, 0.6f}) {
+    FootLockInput far = in;
+    far.anim_toe = far.anim_toe_prev = glm::vec3(away, kFloor, 0.0f);
+    const FootLockStep held = step_foot_lock(s, far, p, kDt);
+    EXPECT_EQ(held.state.state, FootLockState::kLocked) << away;
+    EXPECT_EQ(held.goal, pin) << away;
+  }
+  in.walking = false;
   // Once step_time_s has passed it is pinned again, at the clip's toe.
   s = next.state;
   for (int f = 0; f < 40 && s.state == FootLockState::kStepping; ++f) {
