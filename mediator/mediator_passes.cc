@@ -32,13 +32,23 @@ void for_each_agent(const PassCrowd& c, Fn&& fn) {
 }
 
 // Speed bracket within one direction group, with the standing clip at speed 0 below it.
+//
+// Below the slowest clip a person both shortens the step and slows the cadence, keeping the walk
+// ratio (step length over cadence) about constant (GAIT.md): at a share x of the slowest clip's
+// speed, cadence and step length are both about sqrt(x) of its own. The blend with the standing
+// clip shortens the stride by the gait clip's weight u, and the playback rate (speed over the
+// blend's native speed, x / u) sets the cadence: u = sqrt(x) gives both sqrt(x), down to the
+// slowest cadence allowed (min_rate), below which the cadence stays there and the stride shortens
+// alone. (Weighting by x alone kept the slowest clip's cadence at any speed and folded all of the
+// slowing into the standing blend, which also flattens the swing.)
 void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, float speed,
-                       float share, std::span<float> w) {
+                       float share, float min_rate, std::span<float> w) {
   if (share <= 0.0f) return;
   const std::vector<int>& c = g.clips;
   const float first = lib.clips[c.front()].speed_m_s;
   if (speed <= first) {
-    const float u = std::clamp(speed / first, 0.0f, 1.0f);
+    const float x = std::clamp(speed / first, 0.0f, 1.0f);
+    const float u = std::min(std::sqrt(x), x / std::max(min_rate, 1e-3f));
     w[lib.idle] += share * (1.0f - u);
     w[c.front()] += share * u;
     return;
@@ -58,7 +68,8 @@ void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, fl
 }  // namespace
 
 void choose_clip_weights(const LocomotionLibrary& lib, const MediatorParams& params, float speed,
-                         float rel_dir, std::span<float> w) {
+                         float rel_dir, std::span<float> w, float min_cadence) {
+  const float min_rate = std::max(params.min_playback_rate, min_cadence);
   std::fill(w.begin(), w.end(), 0.0f);
   if (speed < params.stop_speed_m_s) {
     w[lib.idle] = 1.0f;
@@ -81,7 +92,7 @@ void choose_clip_weights(const LocomotionLibrary& lib, const MediatorParams& par
   }
   const std::vector<DirectionGroup>& groups = lib.groups;
   if (groups.size() == 1) {
-    add_group_weights(lib, groups[0], speed, 1.0f, w);
+    add_group_weights(lib, groups[0], speed, 1.0f, min_rate, w);
     return;
   }
   // The two groups whose directions bracket rel_dir (circularly), interpolated by angle.
@@ -98,8 +109,8 @@ void choose_clip_weights(const LocomotionLibrary& lib, const MediatorParams& par
   float off = wrap_pi(rel_dir - a);
   if (off < 0.0f) off += 2.0f * kPi;
   const float u = std::clamp(off / span, 0.0f, 1.0f);
-  add_group_weights(lib, groups[lo], speed, 1.0f - u, w);
-  add_group_weights(lib, groups[hi], speed, u, w);
+  add_group_weights(lib, groups[lo], speed, 1.0f - u, min_rate, w);
+  add_group_weights(lib, groups[hi], speed, u, min_rate, w);
 }
 
 void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const glm::vec2> root_xz,
@@ -205,8 +216,9 @@ void facing_pass(const PassCrowd& c, std::span<const float> root_heading,
 }
 
 void weights_pass(const PassCrowd& c, std::span<const float> speed_m_s,
-                  std::span<const float> rel_dir, ClipWeights cw, std::span<int16_t> layer_clip,
-                  std::span<float> layer_weight, std::span<float> out_blend_progress) {
+                  std::span<const float> rel_dir, std::span<const float> min_cadence,
+                  ClipWeights cw, std::span<int16_t> layer_clip, std::span<float> layer_weight,
+                  std::span<float> out_blend_progress) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   const size_t nc = lib.clips.size();
@@ -216,7 +228,7 @@ void weights_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     // Target blend weights, faded toward over the blend time (APM) or switched at once.
     const std::span<float> w = cw.faded.subspan(slot * nc, nc);
     const std::span<float> target_w = cw.target.subspan(slot * nc, nc);
-    choose_clip_weights(lib, P, speed_m_s[slot], rel_dir[slot], target_w);
+    choose_clip_weights(lib, P, speed_m_s[slot], rel_dir[slot], target_w, min_cadence[slot]);
     if (apm && !c.fresh[slot]) {
       const float step = dt / P.blend_time_s;
       float diff = 0.0f;
@@ -343,9 +355,9 @@ bool phase_passed(float from, float to, float target) {
 }  // namespace
 
 void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
-                     std::span<const uint8_t> standing, std::span<int16_t> layer_clip,
-                     std::span<float> layer_weight, std::span<float> gait_weight,
-                     std::span<float> phase, TransitionState st) {
+                     std::span<const float> playback_rate, std::span<const uint8_t> standing,
+                     std::span<int16_t> layer_clip, std::span<float> layer_weight,
+                     std::span<float> gait_weight, std::span<float> phase, TransitionState st) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   const bool play = is_apm(c) && !lib.transitions.empty();
@@ -360,6 +372,7 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       st.index[slot] = -1;
       st.stage[slot] = TransitionStage::kNone;
       st.weight[slot] = st.time_s[slot] = st.waited_s[slot] = st.lag_m[slot] = 0.0f;
+      st.min_cadence[slot] = 0.0f;
       st.rate[slot] = 1.0f;
       st.still_s[slot] = st.moving_s[slot] = 0.0f;
       st.prev_speed_m_s[slot] = v;
@@ -388,6 +401,7 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       stage = TransitionStage::kNone;
       index = -1;
       w = 0.0f;
+      st.min_cadence[slot] = 0.0f;
     }
     if (stop_seen) ++counts[kStopsSeen];
     if (start_seen) {
@@ -423,6 +437,9 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
           index = static_cast<int16_t>(k);
           stage = TransitionStage::kWaiting;
           st.waited_s[slot] = 0.0f;
+          // A walker who has chosen to stop keeps the cadence to the step the stop begins on
+          // (the slowing shortens the steps, as the stop clip then does): the weights hold it.
+          st.min_cadence[slot] = playback_rate[slot];
           t = entry;
           w = 0.0f;
         }
@@ -438,15 +455,19 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     if (stage == TransitionStage::kWaiting) {
       // The stop begins on the gait phase its first landing matches; it is given up if the agent
       // speeds up again, stands before that phase comes, or the phase does not come within a
-      // cycle (the agent is not walking).
+      // cycle at the held cadence (the agent is not walking).
       st.waited_s[slot] += dt;
       float entry_phase = tr.cycle_phase + (t - tr.moving_from_s) / cycle.cycle_s;
       entry_phase -= std::floor(entry_phase);
-      if (accel > 0.0f || stand || st.waited_s[slot] > cycle.cycle_s + 0.1f) {
+      const float cycle_time =
+          cycle.cycle_s / std::max(st.min_cadence[slot], P.min_playback_rate) + 0.1f;
+      if (accel > 0.0f || stand || st.waited_s[slot] > cycle_time) {
         stage = TransitionStage::kNone;
         index = -1;
+        st.min_cadence[slot] = 0.0f;
       } else if (phase_passed(prev_phase, phase[slot], entry_phase)) {
         stage = TransitionStage::kPlaying;
+        st.min_cadence[slot] = 0.0f;
         float late = phase[slot] - entry_phase;
         if (late < 0.0f) late += 1.0f;
         t += late * cycle.cycle_s;

@@ -107,8 +107,12 @@ inline float heading2(const glm::vec2& v) { return std::atan2(v.x, v.y); }
 // Target clip weights (library.clips.size() of them, summing to 1) for a filtered speed [m/s] and
 // a travel direction relative to the lower body [rad]: standing below the stop speed; the
 // nearest-speed forward clip outside APM; else the (direction, speed) blend space.
+// Below the slowest clip the standing clip's share shortens the stride and the playback rate
+// slows the cadence, both about sqrt of the speed's share (GAIT.md's walk ratio), the cadence no
+// lower than min_playback_rate nor min_cadence (an agent about to stop keeps its cadence).
 void choose_clip_weights(const LocomotionLibrary& library, const MediatorParams& params,
-                         float speed, float rel_dir, std::span<float> out_weights);
+                         float speed, float rel_dir, std::span<float> out_weights,
+                         float min_cadence = 0.0f);
 
 // --- filter -------------------------------------------------------------------------------------
 // Per slot, carried from frame to frame: the simulator's velocity and theta through critically
@@ -160,9 +164,9 @@ struct ClipWeights {
 // and the layers: the kMaxBlendLayers heaviest clips [slot * kMaxBlendLayers + k], normalised.
 // A layer of weight 0 keeps the clip it had.
 void weights_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
-                  std::span<const float> rel_dir, ClipWeights weights,
-                  std::span<int16_t> layer_clip, std::span<float> layer_weight,
-                  std::span<float> out_blend_progress);
+                  std::span<const float> rel_dir, std::span<const float> min_cadence,
+                  ClipWeights weights, std::span<int16_t> layer_clip,
+                  std::span<float> layer_weight, std::span<float> out_blend_progress);
 
 // --- rate and phase -----------------------------------------------------------------------------
 // Reads the layers, the filtered speed, each agent's cadence scale and the lower-body yaw. Writes
@@ -194,6 +198,9 @@ struct TransitionState {
   std::span<float> weight;    // layer weight, 0..1
   std::span<float> rate;      // clip-time step / real time
   std::span<float> waited_s;  // time waited for the phase [s]
+  // Waiting: the playback rate when the stop was chosen, the cadence the weights pass holds
+  // until the stop begins (0: none).
+  std::span<float> min_cadence;
   std::span<float> lag_m;     // playing: the agent's distance travelled minus the clip's [m]
   std::span<float> prev_speed_m_s, prev_phase;
   std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
@@ -218,9 +225,9 @@ inline constexpr float kStopDeceleration = 0.3f;
 // free layer, the others sharing 1 - its weight), the gait share and the phase. A library without
 // transitions changes nothing.
 void transition_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
-                     std::span<const uint8_t> standing, std::span<int16_t> layer_clip,
-                     std::span<float> layer_weight, std::span<float> gait_weight,
-                     std::span<float> phase, TransitionState state);
+                     std::span<const float> playback_rate, std::span<const uint8_t> standing,
+                     std::span<int16_t> layer_clip, std::span<float> layer_weight,
+                     std::span<float> gait_weight, std::span<float> phase, TransitionState state);
 
 // --- contacts -----------------------------------------------------------------------------------
 // Per slot, per foot: what the clips do with each foot this frame.

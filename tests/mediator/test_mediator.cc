@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "animation/pose_jobs.h"
+#include "mediator/mediator_passes.h"
 #include "mediator/springs.h"
 #include "tests/mediator/mediator_fixture.h"
 
@@ -52,6 +53,32 @@ TEST(Mediator, PlaybackRateStaysWithinLimitsOverASpeedRamp) {
   EXPECT_EQ(r.report.pop_count, 0);
   // 3.6 m/s run x 1.35 rate x 1.2 warp = 5.83 m/s: 5 m/s is deliverable, so no feedback.
   EXPECT_FALSE(r.report.feedback_speed_change.has_value());
+}
+
+// Below the slowest clip a walker keeps the walk ratio (GAIT.md: step length over cadence about
+// constant), so at a share x of that clip's speed both the cadence (the playback rate, x over the
+// gait weight) and the stride (the gait weight, the rest standing) are about sqrt(x) of the
+// clip's own, the cadence no slower than min_playback_rate (then the stride shortens alone) nor
+// than an agent about to stop holds it.
+TEST(Mediator, BelowTheSlowestClipCadenceAndStrideShareTheSlowing) {
+  const LocomotionLibrary& lib = builtin_library();
+  const MediatorParams p;
+  const int slow = lib.groups[lib.forward_group].clips.front();
+  const float first = lib.clips[slow].speed_m_s;
+  std::vector<float> w(lib.clips.size());
+  for (const float x : {0.9f, 0.64f, 0.5f, 0.3f, 0.1f}) {
+    choose_clip_weights(lib, p, x * first, 0.0f, w);
+    const float gait = w[slow];
+    EXPECT_NEAR(gait + w[lib.idle], 1.0f, 1e-5f) << x;
+    const float cadence = x / gait;  // the playback rate the blend's native speed asks for
+    EXPECT_NEAR(cadence, std::max(std::sqrt(x), p.min_playback_rate), 1e-4f) << x;
+    if (std::sqrt(x) >= p.min_playback_rate) {
+      EXPECT_NEAR(gait, std::sqrt(x), 1e-4f) << x;
+    }
+    // An agent about to stop that walked at cadence 0.95 keeps it.
+    choose_clip_weights(lib, p, x * first, 0.0f, w, 0.95f);
+    EXPECT_NEAR(x / w[slow], 0.95f, 1e-4f) << x;
+  }
 }
 
 TEST(Mediator, TorsionNeverExceedsTheLimit) {
