@@ -64,9 +64,10 @@ struct FootLockInput {
   // it back to the clip's foot, so a drift alone starts no re-planting step (a step would lift it
   // while the other foot may still be rolling down onto its ball: both off the ground).
   bool walking = false;
-  // Walking, the other foot is coming down or planted but not pinned yet: this one keeps its
-  // weight (its lock) until the other has taken it over, as a trailing foot stays down until the
-  // leading one is flat. (Running has a flight phase: no such wait.)
+  // The other foot is in the air and coming down (walking: in the clips and not pinned yet; or in
+  // a re-planting step): this one keeps its weight (its lock) until the other has taken it over,
+  // as a trailing foot stays down until the leading one is flat. (Running has a flight phase: no
+  // such wait.)
   bool other_landing = false;
   float floor_toe_m = 0.0f;  // where planted toes are (library floor) [m]
   // A ball this slow over the ground is at rest (clip analysis's "still": half the travel speed,

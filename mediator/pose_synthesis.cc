@@ -517,8 +517,12 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     in.walking = pl.gait_weight[slot] >= kGaitVoteWeight;
     const bool other_coming_down =
         pl.plant[1 - side][slot] >= 0.5f || pl.swing_progress[1 - side][slot] >= 0.5f;
-    in.other_landing = pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&
-                       other != FootLockState::kStepping && other_coming_down;
+    // The other foot is in the air and will come down: walking, coming down in the clips and not
+    // pinned yet; or in a re-planting step (as when a standing agent sets off: the first step of
+    // the clips waits until the re-planting foot is down, never both feet in the air).
+    in.other_landing = other == FootLockState::kStepping ||
+                       (pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&
+                        other_coming_down);
     in.floor_toe_m = library_.planted_toe_m[side];
     in.still_speed_m_s = still_speed_m_s(pl.speed_m_s[slot]);
     const FootLockStep next = step_foot_lock(locks_.lock[k], in, lp, dt);
@@ -557,6 +561,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
 
   glm::quat ankle_world_rot[2];
   bool use_ik[2] = {false, false};
+  bool repin[2] = {false, false};
   glm::vec3 toe_offset[2];
   for (int side = 0; side < 2; ++side) {
     const Side sd = static_cast<Side>(side);
@@ -627,10 +632,13 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       // Overstretched even with the pelvis down and the heel up: the foot steps to where the clip
       // has it while the clip keeps it on the ground, and is let go when the clip lifts it.
       const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
-      const bool other_locked =
-          locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
-      if (pl.plant[side][slot] >= 0.5f && other_locked) {
+      const FootLockState other_state = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
+      if (pl.plant[side][slot] >= 0.5f && other_state == FootLockState::kLocked) {
         locks_.lock[k] = start_foot_step(locks_.lock[k], drawn);
+      } else if (other_state == FootLockState::kStepping) {
+        // The other foot is in the air: this one keeps the weight and is re-pinned where the leg
+        // reaches (after the IK below) rather than lifted as well.
+        repin[side] = true;
       } else {
         // Both in the space of the lock's goals (the body before its drop): the offset is what
         // really separates the drawn toe from the clip's, not the drop as well.
@@ -672,6 +680,13 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   }
   fk_ranges(slot, use_ik[0] ? subtree(skeleton_.ankle(Side::kLeft)) : JointRange{},
             use_ik[1] ? subtree(skeleton_.ankle(Side::kRight)) : JointRange{}, placed);
+  for (int side = 0; side < 2; ++side) {
+    if (!repin[side]) continue;
+    const glm::vec3 toe = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+    FootLock& lock = locks_.lock[static_cast<size_t>(slot) * 2 + side];
+    lock.target.x = toe.x;
+    lock.target.z = toe.z;
+  }
 }
 
 float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,

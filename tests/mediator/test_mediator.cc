@@ -12,6 +12,8 @@
 #include "mediator/mediator_passes.h"
 #include "mediator/springs.h"
 #include "tests/mediator/mediator_fixture.h"
+#include "tests/mediator/scripted_crowd.h"
+#include "pipeline/crowd_pipeline.h"
 
 namespace gk {
 namespace {
@@ -79,6 +81,43 @@ TEST(Mediator, BelowTheSlowestClipCadenceAndStrideShareTheSlowing) {
     choose_clip_weights(lib, p, x * first, 0.0f, w, 0.95f);
     EXPECT_NEAR(x / w[slow], 0.95f, 1e-4f) << x;
   }
+}
+
+// Agents that stand, then set off in every direction (a turn on the spot re-plants a foot while
+// the clips still stand): the clips' first step waits until a re-planting foot is down, so a
+// stepping foot always has the other one pinned, and the re-planting step is never released while
+// the other foot is in the air: never both feet in the air at a walk.
+TEST(Mediator, SettingOffFromStandingNeverLiftsBothFeet) {
+  constexpr float kDt = 1.0f / 60.0f;
+  std::vector<Script> s;
+  for (int i = 0; i < 8; ++i) {
+    const float a = 0.25f * std::numbers::pi_v<float> * static_cast<float>(i);
+    const glm::vec2 dir(std::sin(a), std::cos(a));
+    s.push_back({{3.0f * i, 0.0f}, [dir](double t) {
+                   const double u = std::clamp((t - 1.0) / 1.0, 0.0, 1.0);
+                   return static_cast<float>(1.3 * u * u * (3.0 - 2.0 * u)) * dir;
+                 },
+                 nullptr});
+  }
+  test::ScriptedCrowd crowd(std::move(s));
+  CrowdPipeline pipeline(builtin_library(), MediatorParams{},
+                         test::test_pipeline_options(crowd.capacity(), kDt));
+  int steps = 0;
+  for (int f = 0; f < 240; ++f) {
+    ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+    const AnimationPlans& pl = pipeline.mediator().plans();
+    const FootLocks& locks = pipeline.poses().foot_locks();
+    for (size_t i = 0; i < crowd.capacity(); ++i) {
+      const size_t slot = static_cast<size_t>(pl.slot_of_agent[i]);
+      const FootLockState l = locks.lock[slot * 2].state, r = locks.lock[slot * 2 + 1].state;
+      for (const auto& [one, other] : {std::pair{l, r}, std::pair{r, l}}) {
+        if (one != FootLockState::kStepping) continue;
+        ++steps;
+        EXPECT_EQ(other, FootLockState::kLocked) << "agent " << i << " frame " << f;
+      }
+    }
+  }
+  EXPECT_GT(steps, 0) << "no agent re-planted a foot: the test saw nothing";
 }
 
 TEST(Mediator, TorsionNeverExceedsTheLimit) {
