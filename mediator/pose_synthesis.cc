@@ -365,8 +365,12 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   if (twisting) {
     twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
-  if (locking) lock_feet(pl, P, slot, root, dt);
-  finish_pose(slot, detail, locking);
+  // Leaving full detail, the locks are let go through their releases (a reset would snap each
+  // pinned foot to the clip's at once); once every foot is free the agent runs without them.
+  const bool letting_go = apm && P.foot_locking && detail == PoseDetail::kNoFootLocks &&
+                          !pl.fresh[slot] && locks_held(slot);
+  if (locking || letting_go) lock_feet(pl, P, slot, root, dt, letting_go);
+  finish_pose(slot, detail, locking || letting_go);
 }
 
 // What every posed agent ends with: headings, the rotation change, the drawn toes, the foot locks
@@ -489,8 +493,16 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
 }
 
+bool PoseSynthesizer::locks_held(int slot) const {
+  for (int side = 0; side < 2; ++side) {
+    const FootLock& l = locks_.lock[static_cast<size_t>(slot) * 2 + side];
+    if (l.state != FootLockState::kFree || glm::dot(l.offset, l.offset) > 1e-8f) return true;
+  }
+  return false;
+}
+
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
-                                const glm::mat4& root, float dt) {
+                                const glm::mat4& root, float dt, bool letting_go) {
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
                           library_.swing_height_m, library_.swing_speed_m_s};
@@ -509,11 +521,11 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     in.anim_toe_prev = locks_.anim_toe[k];
     in.drawn_toe_prev = locks_.drawn_toe[k];
     in.fresh = pl.fresh[slot] != 0;
-    in.plant = pl.plant[side][slot] >= 0.5f;
+    in.plant = !letting_go && pl.plant[side][slot] >= 0.5f;
     in.hold = pl.hold[side][slot] >= 0.5f;
     in.swing_progress = pl.swing_progress[side][slot];
     const FootLockState other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
-    in.other_locked = other == FootLockState::kLocked;
+    in.other_locked = !letting_go && other == FootLockState::kLocked;
     in.walking = pl.gait_weight[slot] >= kGaitVoteWeight;
     const bool other_coming_down =
         pl.plant[1 - side][slot] >= 0.5f || pl.swing_progress[1 - side][slot] >= 0.5f;
@@ -633,7 +645,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       // has it while the clip keeps it on the ground, and is let go when the clip lifts it.
       const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
       const FootLockState other_state = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
-      if (pl.plant[side][slot] >= 0.5f && other_state == FootLockState::kLocked) {
+      if (!letting_go && pl.plant[side][slot] >= 0.5f && other_state == FootLockState::kLocked) {
         locks_.lock[k] = start_foot_step(locks_.lock[k], drawn);
       } else if (other_state == FootLockState::kStepping) {
         // The other foot is in the air: this one keeps the weight and is re-pinned where the leg

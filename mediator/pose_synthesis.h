@@ -110,8 +110,13 @@ class PoseSynthesizer {
   // Forward kinematics of two ranges (overlapping ones in one pass).
   void fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root);
   void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
+  // Foot locks and leg IK. letting_go: the agent has left full detail, so no foot is pinned anew
+  // (nor re-planted by a step); the locks it still has are let go as the clips lift each foot,
+  // through the usual release, so nothing snaps.
   void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
-                 float dt);
+                 float dt, bool letting_go = false);
+  // Any foot of the slot still pinned, stepping or shedding a release offset.
+  bool locks_held(int slot) const;
 
   const LocomotionLibrary& library_;
   const Skeleton& skeleton_;
