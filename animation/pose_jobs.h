@@ -28,6 +28,22 @@ struct SampleClipJob {
   void run() const;
 };
 
+// Two clips sampled and blended (weights normalised) straight into the output: the same numbers
+// as SampleClipJob into two layers and BlendPosesJob over them, without the layers' buffers (each
+// sample stays in registers until it is blended).
+struct SampleBlendJob {
+  struct Input {
+    const Clip* clip = nullptr;
+    float time_s = 0.0f;
+    float weight = 0.0f;  // > 0
+  };
+  Input a, b;  // clips of the same skeleton
+  std::span<glm::quat> out_rotations;     // num_joints
+  std::span<glm::vec3> out_translations;  // num_joints
+  bool validate() const;
+  void run() const;
+};
+
 // One input of a blend: a local pose and its weight (weights need not sum to 1; they are
 // normalised; layers with weight <= 0 are skipped).
 struct PoseLayer {
@@ -102,9 +118,16 @@ struct SkinningPaletteJob {
   // With affine_inverse_bind: write the palette past the caches (non-temporal stores), for a
   // crowd's palettes, far more than the caches hold and read only later by the upload.
   bool stream_out = false;
+  // With stream_out: end with a store fence (streamed stores are ordered before whatever follows).
+  // Off, the caller fences once after many palettes (stream_fence()): a fence per palette waits
+  // for each one's stores to reach memory.
+  bool fence = true;
   bool validate() const;
   void run() const;
 };
+
+// Orders the streamed stores of SkinningPaletteJobs run with fence off before what follows.
+void stream_fence();
 
 // The smallest |dot(a[j], b[j])| over j (1 when empty): the largest angle between two poses'
 // rotations is 2 acos of it. Four joints at a time, glm's dot to the bit.

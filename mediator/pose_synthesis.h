@@ -98,7 +98,12 @@ class PoseSynthesizer {
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
+  void prefetch_agent(const AnimationPlans& pl, int slot, std::span<const uint8_t> detail) const;
   void pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot, Scratch& s);
+  // Pointers, not spans: a span passed on the stack is read back whole, which the store buffer
+  // cannot forward from its two halves (the load then waits for every pending pose store).
+  void sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
+                     glm::quat* out_rot, glm::vec3* out_trans, size_t n);
   void finish_pose(int slot, PoseDetail detail, bool locking);
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
   void fk(int slot, int from, int to, const glm::mat4& root);
@@ -162,7 +167,8 @@ float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
                      float limit, bool closed_form = true);
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
-// +z; rest_forward is that +z in the joint's own frame): heading [rad].
+// +z; rest_forward is that +z in the joint's own frame): heading [rad], by fast_atan2
+// (animation/fast_atan2.h: within 3e-7 rad).
 float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward);
 
 }  // namespace gk
