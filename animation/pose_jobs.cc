@@ -226,8 +226,10 @@ glm::vec3 wrap_step(const Clip& clip, const FramePair& fp) {
 #if defined(__SSE2__)
 // One clip's rotations of joints [j, j + 4) at its frame pair (SampleClipJob's arithmetic).
 // Inlined: a call would pass the four registers of the result through memory.
-[[gnu::always_inline]] inline Quat4 sample4(const Clip& clip, const FramePair& fp, int j, __m128 s4, __m128 t4) {
-  const Quat4 a = load4(clip.frame_rotations(fp.i0) + j), b = load4(clip.frame_rotations(fp.i1) + j);
+[[gnu::always_inline]] inline Quat4 sample4(const Clip& clip, const FramePair& fp, int j, __m128 s4,
+                                            __m128 t4) {
+  const Quat4 a = load4(clip.frame_rotations(fp.i0) + j),
+              b = load4(clip.frame_rotations(fp.i1) + j);
   const __m128 negate = _mm_cmplt_ps(dot4(a, b), _mm_setzero_ps());
   return normalize4(weighted_sum4(a, s4, b, t4, negate));
 }
@@ -642,6 +644,31 @@ float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b) {
   }
 #endif
   for (; j < n; ++j) d_min = std::min(d_min, std::abs(glm::dot(a[j], b[j])));
+  return d_min;
+}
+
+float min_abs_dot_then_copy(std::span<const glm::quat> a, std::span<glm::quat> b) {
+  const size_t n = std::min(a.size(), b.size());
+  float d_min = 1.0f;
+  size_t j = 0;
+#if defined(__SSE2__)
+  if (n >= 4) {  // min_abs_dot's loop, each group copied once it is read
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 m = _mm_set1_ps(1.0f);
+    for (; j + 4 <= n; j += 4) {
+      const Quat4 qa = load4(a.data() + j);
+      m = _mm_min_ps(_mm_and_ps(dot4(qa, load4(b.data() + j)), abs_mask), m);
+      for (size_t k = 0; k < 4; ++k) b[j + k] = a[j + k];
+    }
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, m);
+    d_min = std::min(std::min(lanes[0], lanes[1]), std::min(lanes[2], lanes[3]));
+  }
+#endif
+  for (; j < n; ++j) {
+    d_min = std::min(d_min, std::abs(glm::dot(a[j], b[j])));
+    b[j] = a[j];
+  }
   return d_min;
 }
 

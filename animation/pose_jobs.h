@@ -133,6 +133,10 @@ void stream_fence();
 // rotations is 2 acos of it. Four joints at a time, glm's dot to the bit.
 float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b);
 
+// min_abs_dot(a, b), and then b = a (a pose's rotations kept as the next frame's previous ones):
+// one pass over both.
+float min_abs_dot_then_copy(std::span<const glm::quat> a, std::span<glm::quat> b);
+
 // True when every matrix's bottom row is exactly 0 0 0 1.
 bool is_affine(std::span<const glm::mat4> matrices);
 

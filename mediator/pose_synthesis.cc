@@ -222,6 +222,16 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
       if (read[j]) pre_twist_joints_.push_back(static_cast<int16_t>(j));
     }
   }
+  // The pelvis is posed before the twist and the leg IK and neither moves it (outside their
+  // ranges): its heading measured for the twist is the final one.
+  if (can_twist_) {
+    auto outside = [&](JointRange r) { return hips < r.from || hips >= r.to; };
+    pelvis_stays_ = outside(twist_range_);
+    for (Side side : {Side::kLeft, Side::kRight}) {
+      pelvis_stays_ = pelvis_stays_ && outside(leg_above_ankle_[static_cast<int>(side)]) &&
+                      outside(subtree(skeleton_.ankle(side)));
+    }
+  }
   affine_inverse_bind_ = is_affine(inverse_bind_);
   // A crowd's palettes far larger than the caches are written past them (read only by the
   // upload, after the whole crowd is posed); a small crowd's stay cached for it.
@@ -449,28 +459,35 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
   if (locking) lock_feet(pl, P, slot, root, dt);
-  finish_pose(slot, detail, locking);
+  // The twist measured the pelvis's heading, and nothing since moved the pelvis.
+  finish_pose(slot, detail, locking, twisting && can_twist_ && pelvis_stays_);
 }
 
 // What every posed agent ends with: headings, the rotation change, the drawn toes, the foot locks
 // reset when off, and the skinning palette.
-void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking) {
+void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, bool pelvis_known) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   const bool track_rotation = detail != PoseDetail::kLight;
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
-    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+    if (!pelvis_known) {
+      pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+    }
     upper_heading_[slot] = joint_heading(world_[base + chest], rest_forward_[chest]);
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
+  bool kept = false;  // this pose's rotations are already kept as the previous ones
   if (track_rotation && prev_rot_valid_[slot] && has_prev_[slot] && J > 1) {
     // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
-    // Joint 0 carries the root facing, not a local bend.
-    change = 2.0f * std::acos(min_abs_dot({local_rot_.data() + base + 1, J - 1},
-                                          {prev_local_rot_.data() + base + 1, J - 1}));
+    // Joint 0 carries the root facing, not a local bend. The rotations are kept for the next
+    // frame as they are read.
+    prev_local_rot_[base] = local_rot_[base];
+    change = 2.0f * std::acos(min_abs_dot_then_copy({local_rot_.data() + base + 1, J - 1},
+                                                    {prev_local_rot_.data() + base + 1, J - 1}));
+    kept = true;
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -489,7 +506,9 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking) {
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
     }
   }
-  if (track_rotation) std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
+  if (track_rotation && !kept) {
+    std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
+  }
   prev_rot_valid_[slot] = track_rotation;
   has_prev_[slot] = 1;
   if (make_palettes_) {
@@ -521,7 +540,7 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   coarse_to_world(coarse_, skeleton_, rot, trans, root,
                   {world_.data() + base, static_cast<size_t>(num_joints_)});
-  finish_pose(slot, PoseDetail::kLight, /*locking=*/false);
+  finish_pose(slot, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
 }
 
 void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {
@@ -530,6 +549,7 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   if (chain.empty() || hips < 0 || chest < 0) return;
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const float pelvis = joint_heading(world_[base + hips], rest_forward_[hips]);
+  pelvis_heading_[slot] = pelvis;  // finish_pose's too when nothing moves the pelvis after
   const float chest_now = joint_heading(world_[base + chest], rest_forward_[chest]);
   // The chest should face upper_yaw, but never further than the limit from the pelvis.
   // Unwrapped against last frame's torsion: theta passing behind the back must not flip the twist

@@ -104,7 +104,8 @@ class PoseSynthesizer {
   // cannot forward from its two halves (the load then waits for every pending pose store).
   void sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
                      glm::quat* out_rot, glm::vec3* out_trans, size_t n);
-  void finish_pose(int slot, PoseDetail detail, bool locking);
+  // pelvis_known: pelvis_heading_[slot] is already this pose's (twist_spine measured it).
+  void finish_pose(int slot, PoseDetail detail, bool locking, bool pelvis_known);
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
   void fk(int slot, int from, int to, const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
@@ -150,6 +151,7 @@ class PoseSynthesizer {
   // the twist reads before it changes them (the chain, the chest and their ancestors in it): the
   // rest of the range is posed once, after the twist.
   bool can_twist_ = false;
+  bool pelvis_stays_ = false;  // the pelvis is outside the twist's and the leg IK's ranges
   JointRange twist_range_;
   std::vector<int16_t> pre_twist_joints_;
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
