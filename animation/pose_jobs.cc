@@ -226,13 +226,21 @@ glm::vec3 wrap_step(const Clip& clip, const FramePair& fp) {
 #if defined(__SSE2__)
 // One clip's rotations of joints [j, j + 4) at its frame pair (SampleClipJob's arithmetic).
 // Inlined: a call would pass the four registers of the result through memory.
-[[gnu::always_inline]] inline Quat4 sample4(const Clip& clip, const FramePair& fp, int j, __m128 s4,
+[[gnu::always_inline]] inline Quat4 sample4(const glm::quat* r0, const glm::quat* r1, __m128 s4,
                                             __m128 t4) {
-  const Quat4 a = load4(clip.frame_rotations(fp.i0) + j),
-              b = load4(clip.frame_rotations(fp.i1) + j);
+  const Quat4 a = load4(r0), b = load4(r1);
   const __m128 negate = _mm_cmplt_ps(dot4(a, b), _mm_setzero_ps());
   return normalize4(weighted_sum4(a, s4, b, t4, negate));
 }
+
+// The last count (< 4) rotations from q, padded with identities to four: the joints a SIMD loop
+// leaves go through it too (a lane computes what the scalar code would; the padding is dropped).
+struct Tail4 {
+  glm::quat q[4];
+  Tail4(const glm::quat* from, int count) {
+    for (int k = 0; k < 4; ++k) q[k] = k < count ? from[k] : glm::quat(1, 0, 0, 0);
+  }
+};
 #endif
 
 }  // namespace
@@ -249,7 +257,14 @@ void SampleClipJob::run() const {
   int j = 0;
 #if defined(__SSE2__)
   const __m128 s4 = _mm_set1_ps(1.0f - t), t4 = _mm_set1_ps(t);
-  for (; j + 4 <= n; j += 4) store4(sample4(*clip, fp, j, s4, t4), out_rotations.data() + j);
+  for (; j + 4 <= n; j += 4) store4(sample4(r0 + j, r1 + j, s4, t4), out_rotations.data() + j);
+  if (j < n) {
+    const Tail4 a(r0 + j, n - j), b(r1 + j, n - j);
+    glm::quat out[4];
+    store4(sample4(a.q, b.q, s4, t4), out);
+    std::copy_n(out, n - j, out_rotations.data() + j);
+    j = n;
+  }
 #endif
   for (; j < n; ++j) out_rotations[j] = nlerp_shortest(r0[j], r1[j], t);
   weighted_floats(reinterpret_cast<const float*>(p0), 1.0f - t, reinterpret_cast<const float*>(p1),
@@ -278,22 +293,36 @@ void SampleBlendJob::run() const {
   // BlendPosesJob's weights: each over their sum.
   const float inv_total = 1.0f / (a.weight + b.weight);
   const float wa = a.weight * inv_total, wb = b.weight * inv_total;
+  const glm::quat* a0r = a.clip->frame_rotations(fa.i0);
+  const glm::quat* a1r = a.clip->frame_rotations(fa.i1);
+  const glm::quat* b0r = b.clip->frame_rotations(fb.i0);
+  const glm::quat* b1r = b.clip->frame_rotations(fb.i1);
   int j = 0;
 #if defined(__SSE2__)
   const __m128 sa = _mm_set1_ps(1.0f - fa.t), ta = _mm_set1_ps(fa.t);
   const __m128 sb = _mm_set1_ps(1.0f - fb.t), tb = _mm_set1_ps(fb.t);
   const __m128 wa4 = _mm_set1_ps(wa), wb4 = _mm_set1_ps(wb);
-  for (; j + 4 <= n; j += 4) {
-    const Quat4 qa = sample4(*a.clip, fa, j, sa, ta), qb = sample4(*b.clip, fb, j, sb, tb);
+  auto blend4 = [&](const glm::quat* ra0, const glm::quat* ra1, const glm::quat* rb0,
+                    const glm::quat* rb1, glm::quat* out) {
+    const Quat4 qa = sample4(ra0, ra1, sa, ta), qb = sample4(rb0, rb1, sb, tb);
     const __m128 negate = _mm_cmplt_ps(dot4(qa, qb), _mm_setzero_ps());
-    store4(normalize4(weighted_sum4(qa, wa4, qb, wb4, negate)), out_rotations.data() + j);
+    store4(normalize4(weighted_sum4(qa, wa4, qb, wb4, negate)), out);
+  };
+  for (; j + 4 <= n; j += 4) {
+    blend4(a0r + j, a1r + j, b0r + j, b1r + j, out_rotations.data() + j);
+  }
+  if (j < n) {  // the rest padded to four (as the loop below, but for the sign of a zero)
+    const Tail4 ta0(a0r + j, n - j), ta1(a1r + j, n - j), tb0(b0r + j, n - j),
+        tb1(b1r + j, n - j);
+    glm::quat out[4];
+    blend4(ta0.q, ta1.q, tb0.q, tb1.q, out);
+    std::copy_n(out, n - j, out_rotations.data() + j);
+    j = n;
   }
 #endif
   for (; j < n; ++j) {  // BlendPosesJob's loop over the joints its SIMD loop leaves
-    const glm::quat qa = nlerp_shortest(a.clip->frame_rotations(fa.i0)[j],
-                                        a.clip->frame_rotations(fa.i1)[j], fa.t);
-    const glm::quat qb = nlerp_shortest(b.clip->frame_rotations(fb.i0)[j],
-                                        b.clip->frame_rotations(fb.i1)[j], fb.t);
+    const glm::quat qa = nlerp_shortest(a0r[j], a1r[j], fa.t);
+    const glm::quat qb = nlerp_shortest(b0r[j], b1r[j], fb.t);
     glm::quat q(0, 0, 0, 0);
     q += wa * qa;
     q += (glm::dot(qa, qb) < 0.0f ? -wb : wb) * qb;

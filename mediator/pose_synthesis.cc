@@ -219,7 +219,12 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     mark(hips);
     mark(chest);
     for (int j = twist_range_.from; j < twist_range_.to; ++j) {
-      if (read[j]) pre_twist_joints_.push_back(static_cast<int16_t>(j));
+      if (!read[j]) continue;
+      if (!pre_twist_.empty() && pre_twist_.back().to == j) {
+        ++pre_twist_.back().to;  // runs of joints in one pass (four at a time)
+      } else {
+        pre_twist_.push_back({j, j + 1});
+      }
     }
   }
   // The pelvis is posed before the twist and the leg IK and neither moves it (outside their
@@ -450,7 +455,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   if (twisting && can_twist_) {
     // The twist poses its whole range again: before it, only the joints it reads there.
     fk(slot, 0, twist_range_.from, root);
-    for (int16_t j : pre_twist_joints_) fk(slot, j, j + 1, root);
+    for (JointRange r : pre_twist_) fk(slot, r.from, r.to, root);
     fk(slot, twist_range_.to, num_joints_, root);
   } else {
     fk(slot, 0, num_joints_, root);

@@ -153,7 +153,7 @@ class PoseSynthesizer {
   bool can_twist_ = false;
   bool pelvis_stays_ = false;  // the pelvis is outside the twist's and the leg IK's ranges
   JointRange twist_range_;
-  std::vector<int16_t> pre_twist_joints_;
+  std::vector<JointRange> pre_twist_;  // those joints, as runs of consecutive ones
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
