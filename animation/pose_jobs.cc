@@ -302,8 +302,9 @@ void SampleBlendJob::run() const {
   const __m128 sa = _mm_set1_ps(1.0f - fa.t), ta = _mm_set1_ps(fa.t);
   const __m128 sb = _mm_set1_ps(1.0f - fb.t), tb = _mm_set1_ps(fb.t);
   const __m128 wa4 = _mm_set1_ps(wa), wb4 = _mm_set1_ps(wb);
+  // Inlined (a call would pass the sampled rotations through memory).
   auto blend4 = [&](const glm::quat* ra0, const glm::quat* ra1, const glm::quat* rb0,
-                    const glm::quat* rb1, glm::quat* out) {
+                    const glm::quat* rb1, glm::quat* out) __attribute__((always_inline)) {
     const Quat4 qa = sample4(ra0, ra1, sa, ta), qb = sample4(rb0, rb1, sb, tb);
     const __m128 negate = _mm_cmplt_ps(dot4(qa, qb), _mm_setzero_ps());
     store4(normalize4(weighted_sum4(qa, wa4, qb, wb4, negate)), out);
