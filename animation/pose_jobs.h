@@ -29,8 +29,9 @@ struct SampleClipJob {
 };
 
 // Two clips sampled and blended (weights normalised) straight into the output: the same numbers
-// as SampleClipJob into two layers and BlendPosesJob over them, without the layers' buffers (each
-// sample stays in registers until it is blended).
+// as SampleClipJob into two layers and BlendPosesJob over them (but for the sign of a zero, as
+// BlendPosesJob's own four-wide loop), without the layers' buffers (each sample stays in registers
+// until it is blended).
 struct SampleBlendJob {
   struct Input {
     const Clip* clip = nullptr;

@@ -318,17 +318,16 @@ void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
 }
 
 // The slot's planned layers (the library's clips, or with `coarse` their coarse joints' tracks,
-// mediator/coarse_pose.h) sampled and blended into
-// out_rot / out_trans. A take's seam adds a second sample of its clip (take_seam). One sample is
-// sampled straight into the output and two are blended as they are sampled (SampleBlendJob: the
-// same numbers); more go through the scratch layers and BlendPosesJob.
+// mediator/coarse_pose.h) sampled and blended into out_rot / out_trans. A take's seam adds a
+// second sample of its clip (take_seam). One sample is sampled straight into the output and two
+// are blended as they are sampled (SampleBlendJob: the same numbers); more go through the scratch
+// layers and BlendPosesJob.
 void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
                                     glm::quat* out_rot_data, glm::vec3* out_trans_data, size_t n) {
   const std::span<glm::quat> out_rot(out_rot_data, n);
   const std::span<glm::vec3> out_trans(out_trans_data, n);
-  // Kept field by field: a whole Input read back from where it was just written piecewise could
-  // not be forwarded from the store buffer and would wait for it to drain (the last agent's pose
-  // stores, missing the caches).
+  // Kept field by field and read back as written: a whole Input read from fields just stored one
+  // by one cannot be forwarded from the store buffer and waits for it to drain.
   const Clip* clip_of[2 * kMaxBlendLayers];
   float time_of[2 * kMaxBlendLayers], weight_of[2 * kMaxBlendLayers];
   int num_samples = 0;

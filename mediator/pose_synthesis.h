@@ -101,7 +101,7 @@ class PoseSynthesizer {
   void prefetch_agent(const AnimationPlans& pl, int slot, std::span<const uint8_t> detail) const;
   void pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot, Scratch& s);
   // Pointers, not spans: a span passed on the stack is read back whole, which the store buffer
-  // cannot forward from its two halves (the load then waits for every pending pose store).
+  // cannot forward from its two halves (the load then waits for the buffer to drain).
   void sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
                      glm::quat* out_rot, glm::vec3* out_trans, size_t n);
   // pelvis_known: pelvis_heading_[slot] is already this pose's (twist_spine measured it).
