@@ -169,57 +169,200 @@ bool SampleClipJob::validate() const {
          clip->translations.size() == n * clip->num_frames && std::isfinite(time_s);
 }
 
-void SampleClipJob::run() const {
-  const int n = clip->num_joints;
-  const int frames = clip->num_frames;
-  float f = time_s * clip->fps;
+namespace {
+
+// The two frames a clip is sampled between at time_s, and the weight of the second.
+struct FramePair {
   int i0, i1;
   float t;
-  if (clip->loops) {
+};
+
+FramePair frame_pair(const Clip& clip, float time_s) {
+  const int frames = clip.num_frames;
+  float f = time_s * clip.fps;
+  FramePair fp;
+  if (clip.loops) {
     // fmod returns an f already in [0, frames) as it is: skip the call (same bits).
     if (!(f >= 0.0f && f < static_cast<float>(frames))) {
       f = std::fmod(f, static_cast<float>(frames));
       if (f < 0.0f) f += frames;
     }
-    i0 = std::min(static_cast<int>(f), frames - 1);
-    i1 = (i0 + 1) % frames;
-    t = f - i0;
+    fp.i0 = std::min(static_cast<int>(f), frames - 1);
+    fp.i1 = (fp.i0 + 1) % frames;
   } else {
     f = std::clamp(f, 0.0f, static_cast<float>(frames - 1));
-    i0 = std::min(static_cast<int>(f), frames - 1);
-    i1 = std::min(i0 + 1, frames - 1);
-    t = f - i0;
+    fp.i0 = std::min(static_cast<int>(f), frames - 1);
+    fp.i1 = std::min(fp.i0 + 1, frames - 1);
   }
-  const glm::quat* r0 = clip->frame_rotations(i0);
-  const glm::quat* r1 = clip->frame_rotations(i1);
-  const glm::vec3* p0 = clip->frame_translations(i0);
-  const glm::vec3* p1 = clip->frame_translations(i1);
-  // The two frames are somewhere in the clip, likely out of the caches: ask for all their lines
-  // at once rather than one stream after the other.
-  prefetch_bytes(r0, n * sizeof(glm::quat));
-  prefetch_bytes(r1, n * sizeof(glm::quat));
-  prefetch_bytes(p0, n * sizeof(glm::vec3));
-  prefetch_bytes(p1, n * sizeof(glm::vec3));
+  fp.t = f - fp.i0;
+  return fp;
+}
+
+// The two frames are somewhere in the clip, likely out of the caches: ask for all their lines at
+// once rather than one stream after the other.
+void prefetch_frames(const Clip& clip, const FramePair& fp) {
+  const size_t n = static_cast<size_t>(clip.num_joints);
+  prefetch_bytes(clip.frame_rotations(fp.i0), n * sizeof(glm::quat));
+  prefetch_bytes(clip.frame_rotations(fp.i1), n * sizeof(glm::quat));
+  prefetch_bytes(clip.frame_translations(fp.i0), n * sizeof(glm::vec3));
+  prefetch_bytes(clip.frame_translations(fp.i1), n * sizeof(glm::vec3));
+}
+
+// Across a loop's wrap the root keeps travelling: frame 0 of the next loop lies one loop's
+// horizontal root displacement ahead (estimated from the clip's mean root velocity). What to add
+// to the sampled root translation (0 away from the wrap).
+bool crosses_wrap(const Clip& clip, const FramePair& fp) {
+  return clip.loops && fp.i1 < fp.i0 && clip.num_frames > 1;
+}
+glm::vec3 wrap_step(const Clip& clip, const FramePair& fp) {
+  const int frames = clip.num_frames;
+  const glm::vec3 first = clip.frame_translations(0)[0];
+  const glm::vec3 last = clip.frame_translations(frames - 1)[0];
+  glm::vec3 per_loop = (last - first) * (static_cast<float>(frames) / (frames - 1));
+  per_loop.y = 0.0f;
+  return fp.t * per_loop;
+}
+
+#if defined(__SSE2__)
+// One clip's rotations of joints [j, j + 4) at its frame pair (SampleClipJob's arithmetic).
+// Inlined: a call would pass the four registers of the result through memory.
+[[gnu::always_inline]] inline Quat4 sample4(const glm::quat* r0, const glm::quat* r1, __m128 s4,
+                                            __m128 t4) {
+  const Quat4 a = load4(r0), b = load4(r1);
+  const __m128 negate = _mm_cmplt_ps(dot4(a, b), _mm_setzero_ps());
+  return normalize4(weighted_sum4(a, s4, b, t4, negate));
+}
+
+// The last count (< 4) rotations from q, padded with identities to four: the joints a SIMD loop
+// leaves go through it too (a lane computes what the scalar code would; the padding is dropped).
+struct Tail4 {
+  glm::quat q[4];
+  Tail4(const glm::quat* from, int count) {
+    for (int k = 0; k < 4; ++k) q[k] = k < count ? from[k] : glm::quat(1, 0, 0, 0);
+  }
+};
+#endif
+
+}  // namespace
+
+void SampleClipJob::run() const {
+  const int n = clip->num_joints;
+  const FramePair fp = frame_pair(*clip, time_s);
+  const float t = fp.t;
+  const glm::quat* r0 = clip->frame_rotations(fp.i0);
+  const glm::quat* r1 = clip->frame_rotations(fp.i1);
+  const glm::vec3* p0 = clip->frame_translations(fp.i0);
+  const glm::vec3* p1 = clip->frame_translations(fp.i1);
+  prefetch_frames(*clip, fp);
   int j = 0;
 #if defined(__SSE2__)
   const __m128 s4 = _mm_set1_ps(1.0f - t), t4 = _mm_set1_ps(t);
-  for (; j + 4 <= n; j += 4) {
-    const Quat4 a = load4(r0 + j), b = load4(r1 + j);
-    const __m128 negate = _mm_cmplt_ps(dot4(a, b), _mm_setzero_ps());
-    store4(normalize4(weighted_sum4(a, s4, b, t4, negate)), out_rotations.data() + j);
+  for (; j + 4 <= n; j += 4) store4(sample4(r0 + j, r1 + j, s4, t4), out_rotations.data() + j);
+  if (j < n) {
+    const Tail4 a(r0 + j, n - j), b(r1 + j, n - j);
+    glm::quat out[4];
+    store4(sample4(a.q, b.q, s4, t4), out);
+    std::copy_n(out, n - j, out_rotations.data() + j);
+    j = n;
   }
 #endif
   for (; j < n; ++j) out_rotations[j] = nlerp_shortest(r0[j], r1[j], t);
   weighted_floats(reinterpret_cast<const float*>(p0), 1.0f - t, reinterpret_cast<const float*>(p1),
                   t, 3 * static_cast<size_t>(n), reinterpret_cast<float*>(out_translations.data()));
-  if (clip->loops && i1 < i0 && frames > 1) {
-    // Across the wrap the root keeps travelling: frame 0 of the next loop lies one loop's
-    // horizontal root displacement ahead (estimated from the clip's mean root velocity).
-    const glm::vec3 first = clip->frame_translations(0)[0];
-    const glm::vec3 last = clip->frame_translations(frames - 1)[0];
-    glm::vec3 per_loop = (last - first) * (static_cast<float>(frames) / (frames - 1));
-    per_loop.y = 0.0f;
-    out_translations[0] += t * per_loop;
+  if (crosses_wrap(*clip, fp)) out_translations[0] += wrap_step(*clip, fp);
+}
+
+bool SampleBlendJob::validate() const {
+  if (!a.clip || !b.clip || a.clip->num_joints != b.clip->num_joints) return false;
+  if (!(a.weight > 0.0f) || !(b.weight > 0.0f) || !std::isfinite(a.weight + b.weight)) {
+    return false;
+  }
+  for (const Input* in : {&a, &b}) {
+    if (!SampleClipJob{in->clip, in->time_s, out_rotations, out_translations}.validate()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void SampleBlendJob::run() const {
+  const int n = a.clip->num_joints;
+  const FramePair fa = frame_pair(*a.clip, a.time_s), fb = frame_pair(*b.clip, b.time_s);
+  prefetch_frames(*a.clip, fa);
+  prefetch_frames(*b.clip, fb);
+  // BlendPosesJob's weights: each over their sum.
+  const float inv_total = 1.0f / (a.weight + b.weight);
+  const float wa = a.weight * inv_total, wb = b.weight * inv_total;
+  const glm::quat* a0r = a.clip->frame_rotations(fa.i0);
+  const glm::quat* a1r = a.clip->frame_rotations(fa.i1);
+  const glm::quat* b0r = b.clip->frame_rotations(fb.i0);
+  const glm::quat* b1r = b.clip->frame_rotations(fb.i1);
+  int j = 0;
+#if defined(__SSE2__)
+  const __m128 sa = _mm_set1_ps(1.0f - fa.t), ta = _mm_set1_ps(fa.t);
+  const __m128 sb = _mm_set1_ps(1.0f - fb.t), tb = _mm_set1_ps(fb.t);
+  const __m128 wa4 = _mm_set1_ps(wa), wb4 = _mm_set1_ps(wb);
+  // Inlined (a call would pass the sampled rotations through memory).
+  auto blend4 = [&](const glm::quat* ra0, const glm::quat* ra1, const glm::quat* rb0,
+                    const glm::quat* rb1, glm::quat* out) __attribute__((always_inline)) {
+    const Quat4 qa = sample4(ra0, ra1, sa, ta), qb = sample4(rb0, rb1, sb, tb);
+    const __m128 negate = _mm_cmplt_ps(dot4(qa, qb), _mm_setzero_ps());
+    store4(normalize4(weighted_sum4(qa, wa4, qb, wb4, negate)), out);
+  };
+  for (; j + 4 <= n; j += 4) {
+    blend4(a0r + j, a1r + j, b0r + j, b1r + j, out_rotations.data() + j);
+  }
+  if (j < n) {  // the rest padded to four (as the loop below, but for the sign of a zero)
+    const Tail4 ta0(a0r + j, n - j), ta1(a1r + j, n - j), tb0(b0r + j, n - j),
+        tb1(b1r + j, n - j);
+    glm::quat out[4];
+    blend4(ta0.q, ta1.q, tb0.q, tb1.q, out);
+    std::copy_n(out, n - j, out_rotations.data() + j);
+    j = n;
+  }
+#endif
+  for (; j < n; ++j) {  // BlendPosesJob's loop over the joints its SIMD loop leaves
+    const glm::quat qa = nlerp_shortest(a0r[j], a1r[j], fa.t);
+    const glm::quat qb = nlerp_shortest(b0r[j], b1r[j], fb.t);
+    glm::quat q(0, 0, 0, 0);
+    q += wa * qa;
+    q += (glm::dot(qa, qb) < 0.0f ? -wb : wb) * qb;
+    out_rotations[j] = glm::normalize(q);
+  }
+  // Translations: each clip's lerp (its root moved on across a wrap), then the weighted mean.
+  const float* a0 = reinterpret_cast<const float*>(a.clip->frame_translations(fa.i0));
+  const float* a1 = reinterpret_cast<const float*>(a.clip->frame_translations(fa.i1));
+  const float* b0 = reinterpret_cast<const float*>(b.clip->frame_translations(fb.i0));
+  const float* b1 = reinterpret_cast<const float*>(b.clip->frame_translations(fb.i1));
+  float* out = reinterpret_cast<float*>(out_translations.data());
+  const size_t m = 3 * static_cast<size_t>(n);
+  size_t i = 3;  // the root (floats 0-2) first, with the wraps
+  {
+    glm::vec3 ra(a0[0] * (1.0f - fa.t) + a1[0] * fa.t, a0[1] * (1.0f - fa.t) + a1[1] * fa.t,
+                 a0[2] * (1.0f - fa.t) + a1[2] * fa.t);
+    glm::vec3 rb(b0[0] * (1.0f - fb.t) + b1[0] * fb.t, b0[1] * (1.0f - fb.t) + b1[1] * fb.t,
+                 b0[2] * (1.0f - fb.t) + b1[2] * fb.t);
+    if (crosses_wrap(*a.clip, fa)) ra += wrap_step(*a.clip, fa);
+    if (crosses_wrap(*b.clip, fb)) rb += wrap_step(*b.clip, fb);
+    out_translations[0] = glm::vec3(ra.x * wa + rb.x * wb, ra.y * wa + rb.y * wb,
+                                    ra.z * wa + rb.z * wb);
+  }
+#if defined(__SSE2__)
+  const __m128 sa1 = _mm_set1_ps(1.0f - fa.t), ta1 = _mm_set1_ps(fa.t);
+  const __m128 sb1 = _mm_set1_ps(1.0f - fb.t), tb1 = _mm_set1_ps(fb.t);
+  const __m128 wa1 = _mm_set1_ps(wa), wb1 = _mm_set1_ps(wb);
+  for (; i + 4 <= m; i += 4) {
+    const __m128 la = _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(a0 + i), sa1),
+                                 _mm_mul_ps(_mm_loadu_ps(a1 + i), ta1));
+    const __m128 lb = _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(b0 + i), sb1),
+                                 _mm_mul_ps(_mm_loadu_ps(b1 + i), tb1));
+    _mm_storeu_ps(out + i, _mm_add_ps(_mm_mul_ps(la, wa1), _mm_mul_ps(lb, wb1)));
+  }
+#endif
+  for (; i < m; ++i) {
+    const float la = a0[i] * (1.0f - fa.t) + a1[i] * fa.t;
+    const float lb = b0[i] * (1.0f - fb.t) + b1[i] * fb.t;
+    out[i] = la * wa + lb * wb;
   }
 }
 
@@ -491,7 +634,7 @@ void SkinningPaletteJob::run() const {
         _mm_stream_ps(m + 4 * c, col);
       }
     }
-    _mm_sfence();  // the streamed stores are ordered before whatever tells a reader they are done
+    if (fence) stream_fence();
     return;
   }
 #endif
@@ -505,6 +648,12 @@ void SkinningPaletteJob::run() const {
     m[2] = a[0] * b[2][0] + a[1] * b[2][1] + a[2] * b[2][2];
     m[3] = a[0] * b[3][0] + a[1] * b[3][1] + a[2] * b[3][2] + a[3];
   }
+}
+
+void stream_fence() {
+#if defined(__SSE2__)
+  _mm_sfence();  // the streamed stores are ordered before whatever tells a reader they are done
+#endif
 }
 
 float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b) {
@@ -525,6 +674,31 @@ float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b) {
   }
 #endif
   for (; j < n; ++j) d_min = std::min(d_min, std::abs(glm::dot(a[j], b[j])));
+  return d_min;
+}
+
+float min_abs_dot_then_copy(std::span<const glm::quat> a, std::span<glm::quat> b) {
+  const size_t n = std::min(a.size(), b.size());
+  float d_min = 1.0f;
+  size_t j = 0;
+#if defined(__SSE2__)
+  if (n >= 4) {  // min_abs_dot's loop, each group copied once it is read
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 m = _mm_set1_ps(1.0f);
+    for (; j + 4 <= n; j += 4) {
+      const Quat4 qa = load4(a.data() + j);
+      m = _mm_min_ps(_mm_and_ps(dot4(qa, load4(b.data() + j)), abs_mask), m);
+      for (size_t k = 0; k < 4; ++k) b[j + k] = a[j + k];
+    }
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, m);
+    d_min = std::min(std::min(lanes[0], lanes[1]), std::min(lanes[2], lanes[3]));
+  }
+#endif
+  for (; j < n; ++j) {
+    d_min = std::min(d_min, std::abs(glm::dot(a[j], b[j])));
+    b[j] = a[j];
+  }
   return d_min;
 }
 

@@ -28,6 +28,23 @@ struct SampleClipJob {
   void run() const;
 };
 
+// Two clips sampled and blended (weights normalised) straight into the output: the same numbers
+// as SampleClipJob into two layers and BlendPosesJob over them (but for the sign of a zero, as
+// BlendPosesJob's own four-wide loop), without the layers' buffers (each sample stays in registers
+// until it is blended).
+struct SampleBlendJob {
+  struct Input {
+    const Clip* clip = nullptr;
+    float time_s = 0.0f;
+    float weight = 0.0f;  // > 0
+  };
+  Input a, b;  // clips of the same skeleton
+  std::span<glm::quat> out_rotations;     // num_joints
+  std::span<glm::vec3> out_translations;  // num_joints
+  bool validate() const;
+  void run() const;
+};
+
 // One input of a blend: a local pose and its weight (weights need not sum to 1; they are
 // normalised; layers with weight <= 0 are skipped).
 struct PoseLayer {
@@ -102,13 +119,24 @@ struct SkinningPaletteJob {
   // With affine_inverse_bind: write the palette past the caches (non-temporal stores), for a
   // crowd's palettes, far more than the caches hold and read only later by the upload.
   bool stream_out = false;
+  // With stream_out: end with a store fence (streamed stores are ordered before whatever follows).
+  // Off, the caller fences once after many palettes (stream_fence()): a fence per palette waits
+  // for each one's stores to reach memory.
+  bool fence = true;
   bool validate() const;
   void run() const;
 };
 
+// Orders the streamed stores of SkinningPaletteJobs run with fence off before what follows.
+void stream_fence();
+
 // The smallest |dot(a[j], b[j])| over j (1 when empty): the largest angle between two poses'
 // rotations is 2 acos of it. Four joints at a time, glm's dot to the bit.
 float min_abs_dot(std::span<const glm::quat> a, std::span<const glm::quat> b);
+
+// min_abs_dot(a, b), and then b = a (a pose's rotations kept as the next frame's previous ones):
+// one pass over both.
+float min_abs_dot_then_copy(std::span<const glm::quat> a, std::span<glm::quat> b);
 
 // True when every matrix's bottom row is exactly 0 0 0 1.
 bool is_affine(std::span<const glm::mat4> matrices);

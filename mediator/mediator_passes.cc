@@ -579,7 +579,8 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       lt[k] = layer_time(clip, phase[slot], idle_time_s[slot], transition_time_s[slot]);
       if (lw[k] <= 0.0f) continue;
       const int nf = clip.clip.num_frames;
-      auto wrap = [&](int i) {
+      auto wrap = [&](int i) {  // a frame already in range is its own (no division)
+        if (i >= 0 && i < nf) return i;
         return clip.clip.loops ? ((i % nf) + nf) % nf : std::clamp(i, 0, nf - 1);
       };
       const float ft = lt[k] * clip.clip.fps;

@@ -6,6 +6,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "animation/fast_atan2.h"
 #include "animation/pose_jobs.h"
 #include "mediator/coarse_pose.h"
 #include "mediator/springs.h"
@@ -133,7 +134,7 @@ float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward) {
       world[0].x * rest_forward.x + world[1].x * rest_forward.y + world[2].x * rest_forward.z;
   const float z =
       world[0].z * rest_forward.x + world[1].z * rest_forward.y + world[2].z * rest_forward.z;
-  return std::atan2(x, z);
+  return fast_atan2(x, z);
 }
 
 PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capacity,
@@ -218,7 +219,22 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     mark(hips);
     mark(chest);
     for (int j = twist_range_.from; j < twist_range_.to; ++j) {
-      if (read[j]) pre_twist_joints_.push_back(static_cast<int16_t>(j));
+      if (!read[j]) continue;
+      if (!pre_twist_.empty() && pre_twist_.back().to == j) {
+        ++pre_twist_.back().to;  // runs of joints in one pass (four at a time)
+      } else {
+        pre_twist_.push_back({j, j + 1});
+      }
+    }
+  }
+  // The pelvis is posed before the twist and the leg IK and neither moves it (outside their
+  // ranges): its heading measured for the twist is the final one.
+  if (can_twist_) {
+    auto outside = [&](JointRange r) { return hips < r.from || hips >= r.to; };
+    pelvis_stays_ = outside(twist_range_);
+    for (Side side : {Side::kLeft, Side::kRight}) {
+      pelvis_stays_ = pelvis_stays_ && outside(leg_above_ankle_[static_cast<int>(side)]) &&
+                      outside(subtree(skeleton_.ankle(side)));
     }
   }
   affine_inverse_bind_ = is_affine(inverse_bind_);
@@ -241,13 +257,50 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const int slot = pl.slot_of_agent[i];
       const auto d = detail.empty() ? PoseDetail::kFull : static_cast<PoseDetail>(detail[slot]);
+      // The next agent's pose arrays and clip frames are fetched while this one is posed: its
+      // samples are written straight into its pose, which would otherwise wait for those lines.
+      if (i + 1 < r.end()) prefetch_agent(pl, pl.slot_of_agent[i + 1], detail);
       if (d == PoseDetail::kHold && !pl.fresh[slot]) {
         hold_agent(pl, slot);
       } else {
         synthesize_agent(pl, P, slot, dt_s, s, d == PoseDetail::kHold ? PoseDetail::kLight : d);
       }
     }
+    // The range's streamed palettes are ordered before the task's end tells anyone they are done
+    // (one fence here, not one per agent: each waits for the stores before it to reach memory).
+    if (stream_palettes_) stream_fence();
   });
+}
+
+// Asks the caches for what posing `slot` reads and writes first (a hint; no effect on results):
+// its pose arrays, foot locks and the frames of its clip layers; nothing for a held slot.
+void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot,
+                                     std::span<const uint8_t> detail) const {
+  const auto d = detail.empty() ? PoseDetail::kFull : static_cast<PoseDetail>(detail[slot]);
+  if (d == PoseDetail::kHold && !pl.fresh[slot]) return;
+  const bool coarse = d != PoseDetail::kFull && d != PoseDetail::kNoFootLocks && coarse_.useful();
+  const size_t J = num_joints_;
+  const size_t base = static_cast<size_t>(slot) * J;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    if (pl.layer_weight[slot * kMaxBlendLayers + k] <= 0.0f) continue;
+    const int c = pl.layer_clip[slot * kMaxBlendLayers + k];
+    const Clip& clip = coarse ? coarse_.clips[c] : library_.clips[c].clip;
+    const float f = pl.layer_time_s[slot * kMaxBlendLayers + k] * clip.fps;
+    if (!(f >= 0.0f && f < static_cast<float>(clip.num_frames))) continue;  // a wrap: not guessed
+    const int i0 = static_cast<int>(f);
+    const size_t rows = static_cast<size_t>(clip.num_joints) * (i0 + 1 < clip.num_frames ? 2 : 1);
+    prefetch_bytes(clip.frame_rotations(i0), rows * sizeof(glm::quat));  // frames i0 and i0 + 1
+    prefetch_bytes(clip.frame_translations(i0), rows * sizeof(glm::vec3));
+  }
+  prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
+  if (coarse) return;
+  prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
+  prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
+  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
+  if (d != PoseDetail::kFull) return;
+  prefetch_bytes(&locks_.lock[static_cast<size_t>(slot) * 2], 2 * sizeof(FootLock), true);
+  prefetch_bytes(&locks_.anim_toe[static_cast<size_t>(slot) * 2], 2 * sizeof(glm::vec3), true);
+  prefetch_bytes(&locks_.drawn_toe[static_cast<size_t>(slot) * 2], 2 * sizeof(glm::vec3), true);
 }
 
 // An agent not posed this frame: its world joints and palette stay where they were posed and are
@@ -262,6 +315,74 @@ void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
     locks_.drawn_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
     locks_.anim_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
   }
+}
+
+// The slot's planned layers (the library's clips, or with `coarse` their coarse joints' tracks,
+// mediator/coarse_pose.h) sampled and blended into out_rot / out_trans. A take's seam adds a
+// second sample of its clip (take_seam). One sample is sampled straight into the output and two
+// are blended as they are sampled (SampleBlendJob: the same numbers); more go through the scratch
+// layers and BlendPosesJob.
+void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
+                                    glm::quat* out_rot_data, glm::vec3* out_trans_data, size_t n) {
+  const std::span<glm::quat> out_rot(out_rot_data, n);
+  const std::span<glm::vec3> out_trans(out_trans_data, n);
+  // Kept field by field and read back as written: a whole Input read from fields just stored one
+  // by one cannot be forwarded from the store buffer and waits for it to drain.
+  const Clip* clip_of[2 * kMaxBlendLayers];
+  float time_of[2 * kMaxBlendLayers], weight_of[2 * kMaxBlendLayers];
+  int num_samples = 0;
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
+    if (w <= 0.0f) continue;
+    const int c = pl.layer_clip[slot * kMaxBlendLayers + k];
+    const float time = pl.layer_time_s[slot * kMaxBlendLayers + k];
+    // A take (not a loop) replays one stride of itself: its last pose is not quite its first, so
+    // over the stride's last fifth the pose one stride earlier is blended in, and the wrap to the
+    // stride's start joins exactly.
+    const LocomotionClip& lc = library_.clips[c];
+    const Clip* clip = coarse ? &coarse_.clips[c] : &lc.clip;
+    const float seam = take_seam(lc, time);
+    clip_of[num_samples] = clip;
+    time_of[num_samples] = time;
+    weight_of[num_samples++] = w * (1.0f - seam);
+    if (seam > 0.0f) {
+      clip_of[num_samples] = clip;
+      time_of[num_samples] = time - lc.cycle_s;
+      weight_of[num_samples++] = w * seam;
+    }
+  }
+  // BlendPosesJob skips the layers of weight 0 (a seam's full end): so do the fast paths.
+  int num_weighted = 0, a = -1, b = -1;
+  for (int i = 0; i < num_samples; ++i) {
+    if (!(weight_of[i] > 0.0f)) continue;
+    (a < 0 ? a : b) = i;
+    ++num_weighted;
+  }
+  if (num_weighted == 1) {
+    SampleClipJob{clip_of[a], time_of[a], out_rot, out_trans}.run();
+    return;
+  }
+  if (num_weighted == 2) {
+    SampleBlendJob job;
+    job.a.clip = clip_of[a];
+    job.a.time_s = time_of[a];
+    job.a.weight = weight_of[a];
+    job.b.clip = clip_of[b];
+    job.b.time_s = time_of[b];
+    job.b.weight = weight_of[b];
+    job.out_rotations = out_rot;
+    job.out_translations = out_trans;
+    job.run();
+    return;
+  }
+  PoseLayer layers[2 * kMaxBlendLayers];
+  for (int i = 0; i < num_samples; ++i) {
+    std::span<glm::quat> r(s.rot.data() + i * n, n);
+    std::span<glm::vec3> t(s.trans.data() + i * n, n);
+    SampleClipJob{clip_of[i], time_of[i], r, t}.run();
+    layers[i] = {r, t, weight_of[i]};
+  }
+  BlendPosesJob{{layers, static_cast<size_t>(num_samples)}, out_rot, out_trans}.run();
 }
 
 void PoseSynthesizer::fk(int slot, int from, int to, const glm::mat4& root) {
@@ -320,32 +441,8 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   }
 
   // Sample and blend the planned layers.
-  PoseLayer layers[2 * kMaxBlendLayers];
-  int num_layers = 0;
-  for (int k = 0; k < kMaxBlendLayers; ++k) {
-    const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
-    if (w <= 0.0f) continue;
-    const LocomotionClip& lc = library_.clips[pl.layer_clip[slot * kMaxBlendLayers + k]];
-    const float time = pl.layer_time_s[slot * kMaxBlendLayers + k];
-    std::span<glm::quat> r(s.rot.data() + num_layers * J, J);
-    std::span<glm::vec3> t(s.trans.data() + num_layers * J, J);
-    SampleClipJob{&lc.clip, time, r, t}.run();
-    // A take (not a loop) replays one stride of itself: its last pose is not quite its first, so
-    // over the stride's last fifth the pose one stride earlier is blended in, and the wrap to the
-    // stride's start joins exactly.
-    const float seam = take_seam(lc, time);
-    layers[num_layers++] = {r, t, w * (1.0f - seam)};
-    if (seam > 0.0f) {
-      const float earlier = time - lc.cycle_s;
-      std::span<glm::quat> r2(s.rot.data() + num_layers * J, J);
-      std::span<glm::vec3> t2(s.trans.data() + num_layers * J, J);
-      SampleClipJob{&lc.clip, earlier, r2, t2}.run();
-      layers[num_layers++] = {r2, t2, w * seam};
-    }
-  }
-  std::span<glm::quat> out_r(local_rot_.data() + base, J);
-  std::span<glm::vec3> out_t(local_trans_.data() + base, J);
-  BlendPosesJob{{layers, static_cast<size_t>(num_layers)}, out_r, out_t}.run();
+  sample_layers(pl, slot, /*coarse=*/false, s, local_rot_.data() + base, local_trans_.data() + base,
+                J);
 
   const bool apm = P.mode == MediatorMode::kApm;
   const bool locking = apm && P.foot_locking && detail == PoseDetail::kFull;
@@ -357,7 +454,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   if (twisting && can_twist_) {
     // The twist poses its whole range again: before it, only the joints it reads there.
     fk(slot, 0, twist_range_.from, root);
-    for (int16_t j : pre_twist_joints_) fk(slot, j, j + 1, root);
+    for (JointRange r : pre_twist_) fk(slot, r.from, r.to, root);
     fk(slot, twist_range_.to, num_joints_, root);
   } else {
     fk(slot, 0, num_joints_, root);
@@ -370,28 +467,35 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool letting_go = apm && P.foot_locking && detail == PoseDetail::kNoFootLocks &&
                           !pl.fresh[slot] && locks_held(slot);
   if (locking || letting_go) lock_feet(pl, P, slot, root, dt, letting_go);
-  finish_pose(slot, detail, locking || letting_go);
+  // The twist measured the pelvis's heading, and nothing since moved the pelvis.
+  finish_pose(slot, detail, locking || letting_go, twisting && can_twist_ && pelvis_stays_);
 }
 
 // What every posed agent ends with: headings, the rotation change, the drawn toes, the foot locks
 // reset when off, and the skinning palette.
-void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking) {
+void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, bool pelvis_known) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   const bool track_rotation = detail != PoseDetail::kLight;
   // Torsion as measured (pelvis -> chest) and the per-frame rotation change for the pop metric.
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
-    pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+    if (!pelvis_known) {
+      pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+    }
     upper_heading_[slot] = joint_heading(world_[base + chest], rest_forward_[chest]);
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
+  bool kept = false;  // this pose's rotations are already kept as the previous ones
   if (track_rotation && prev_rot_valid_[slot] && has_prev_[slot] && J > 1) {
     // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
-    // Joint 0 carries the root facing, not a local bend.
-    change = 2.0f * std::acos(min_abs_dot({local_rot_.data() + base + 1, J - 1},
-                                          {prev_local_rot_.data() + base + 1, J - 1}));
+    // Joint 0 carries the root facing, not a local bend. The rotations are kept for the next
+    // frame as they are read.
+    prev_local_rot_[base] = local_rot_[base];
+    change = 2.0f * std::acos(min_abs_dot_then_copy({local_rot_.data() + base + 1, J - 1},
+                                                    {prev_local_rot_.data() + base + 1, J - 1}));
+    kept = true;
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -410,7 +514,9 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking) {
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
     }
   }
-  if (track_rotation) std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
+  if (track_rotation && !kept) {
+    std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
+  }
   prev_rot_valid_[slot] = track_rotation;
   has_prev_[slot] = 1;
   if (make_palettes_) {
@@ -420,6 +526,7 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking) {
     job.out_palette = {palette_.data() + base, J};
     job.affine_inverse_bind = affine_inverse_bind_;
     job.stream_out = stream_palettes_;
+    job.fence = false;  // run() fences once per range of agents
     job.run();
   }
 }
@@ -431,29 +538,9 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   const size_t K = static_cast<size_t>(coarse_.num_coarse);
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   prefetch_bytes(world_.data() + base, num_joints_ * sizeof(glm::mat4), true);
-  PoseLayer layers[2 * kMaxBlendLayers];
-  int num_layers = 0;
-  for (int k = 0; k < kMaxBlendLayers; ++k) {
-    const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
-    if (w <= 0.0f) continue;
-    const int c = pl.layer_clip[slot * kMaxBlendLayers + k];
-    const LocomotionClip& lc = library_.clips[c];
-    const float time = pl.layer_time_s[slot * kMaxBlendLayers + k];
-    std::span<glm::quat> r(s.rot.data() + num_layers * K, K);
-    std::span<glm::vec3> t(s.trans.data() + num_layers * K, K);
-    SampleClipJob{&coarse_.clips[c], time, r, t}.run();
-    const float seam = take_seam(lc, time);
-    layers[num_layers++] = {r, t, w * (1.0f - seam)};
-    if (seam > 0.0f) {
-      std::span<glm::quat> r2(s.rot.data() + num_layers * K, K);
-      std::span<glm::vec3> t2(s.trans.data() + num_layers * K, K);
-      SampleClipJob{&coarse_.clips[c], time - lc.cycle_s, r2, t2}.run();
-      layers[num_layers++] = {r2, t2, w * seam};
-    }
-  }
   const std::span<glm::quat> rot(s.coarse_rot.data(), K);
   const std::span<glm::vec3> trans(s.coarse_trans.data(), K);
-  BlendPosesJob{{layers, static_cast<size_t>(num_layers)}, rot, trans}.run();
+  sample_layers(pl, slot, /*coarse=*/true, s, rot.data(), trans.data(), K);
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   placed_xz_[slot] = pl.root_xz[slot];
   root_offset_[slot] = glm::vec2(0.0f);
@@ -461,7 +548,7 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   coarse_to_world(coarse_, skeleton_, rot, trans, root,
                   {world_.data() + base, static_cast<size_t>(num_joints_)});
-  finish_pose(slot, PoseDetail::kLight, /*locking=*/false);
+  finish_pose(slot, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
 }
 
 void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {
@@ -470,6 +557,7 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
   if (chain.empty() || hips < 0 || chest < 0) return;
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const float pelvis = joint_heading(world_[base + hips], rest_forward_[hips]);
+  pelvis_heading_[slot] = pelvis;  // finish_pose's too when nothing moves the pelvis after
   const float chest_now = joint_heading(world_[base + chest], rest_forward_[chest]);
   // The chest should face upper_yaw, but never further than the limit from the pelvis.
   // Unwrapped against last frame's torsion: theta passing behind the back must not flip the twist

@@ -98,8 +98,14 @@ class PoseSynthesizer {
   void synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot, float dt,
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
+  void prefetch_agent(const AnimationPlans& pl, int slot, std::span<const uint8_t> detail) const;
   void pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot, Scratch& s);
-  void finish_pose(int slot, PoseDetail detail, bool locking);
+  // Pointers, not spans: a span passed on the stack is read back whole, which the store buffer
+  // cannot forward from its two halves (the load then waits for the buffer to drain).
+  void sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
+                     glm::quat* out_rot, glm::vec3* out_trans, size_t n);
+  // pelvis_known: pelvis_heading_[slot] is already this pose's (twist_spine measured it).
+  void finish_pose(int slot, PoseDetail detail, bool locking, bool pelvis_known);
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
   void fk(int slot, int from, int to, const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
@@ -150,8 +156,9 @@ class PoseSynthesizer {
   // the twist reads before it changes them (the chain, the chest and their ancestors in it): the
   // rest of the range is posed once, after the twist.
   bool can_twist_ = false;
+  bool pelvis_stays_ = false;  // the pelvis is outside the twist's and the leg IK's ranges
   JointRange twist_range_;
-  std::vector<int16_t> pre_twist_joints_;
+  std::vector<JointRange> pre_twist_;  // those joints, as runs of consecutive ones
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
@@ -167,7 +174,8 @@ float heel_off_pitch(const glm::vec3& toe, const glm::vec3& ankle, const glm::ve
                      float limit, bool closed_form = true);
 
 // Forward direction on the ground of a joint, relative to its rest orientation (the rest pose faces
-// +z; rest_forward is that +z in the joint's own frame): heading [rad].
+// +z; rest_forward is that +z in the joint's own frame): heading [rad], by fast_atan2
+// (animation/fast_atan2.h: within 3e-7 rad).
 float joint_heading(const glm::mat4& world, const glm::vec3& rest_forward);
 
 }  // namespace gk

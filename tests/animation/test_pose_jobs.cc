@@ -179,6 +179,83 @@ TEST(BlendPosesJob, OneWeightedLayerIsCopied) {
   EXPECT_EQ(t, ta);
 }
 
+// A random looping clip of n joints and `frames` frames whose root travels (so a wrap moves it on).
+Clip random_clip(int n, int frames, std::mt19937& rng) {
+  Clip c;
+  c.name = "random";
+  c.fps = 30.0f;
+  c.num_frames = frames;
+  c.num_joints = n;
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::quat> previous;
+  for (int f = 0; f < frames; ++f) {
+    const std::vector<glm::quat> q = random_quats(n, rng, f > 0 ? &previous : nullptr);
+    c.rotations.insert(c.rotations.end(), q.begin(), q.end());
+    previous = q;
+    for (int j = 0; j < n; ++j) {
+      c.translations.push_back(j == 0 ? glm::vec3(0.1f * f, 0.9f + 0.01f * u(rng), 0.05f * u(rng))
+                                      : glm::vec3(u(rng), u(rng), u(rng)));
+    }
+  }
+  return c;
+}
+
+// The fused job is an optimisation of these two: the same bits, at any times (a loop's wrap and
+// its root's step included) and weights, four joints at a time and the remainder.
+TEST(SampleBlendJob, EqualsTwoSamplesAndTheirBlendBitForBit) {
+  std::mt19937 rng(21);
+  for (const int n : {1, 4, 11, 25}) {
+    const Clip a = random_clip(n, 7, rng), b = random_clip(n, 9, rng);
+    std::uniform_real_distribution<float> time(-0.5f, 0.7f), weight(0.01f, 3.0f);
+    for (int trial = 0; trial < 200; ++trial) {
+      // Every third trial at a frame pair across the loop's wrap.
+      const float ta = trial % 3 == 0 ? (a.num_frames - 0.4f) / a.fps : time(rng);
+      const float tb = trial % 3 == 0 ? (b.num_frames - 0.7f) / b.fps : time(rng);
+      const float wa = weight(rng), wb = weight(rng);
+      std::vector<glm::quat> ra(n), rb(n), want_r(n), got_r(n);
+      std::vector<glm::vec3> pa(n), pb(n), want_t(n), got_t(n);
+      SampleClipJob{&a, ta, ra, pa}.run();
+      SampleClipJob{&b, tb, rb, pb}.run();
+      const PoseLayer layers[2] = {{ra, pa, wa}, {rb, pb, wb}};
+      BlendPosesJob{layers, want_r, want_t}.run();
+      SampleBlendJob job;
+      job.a = {&a, ta, wa};
+      job.b = {&b, tb, wb};
+      job.out_rotations = got_r;
+      job.out_translations = got_t;
+      ASSERT_TRUE(job.validate());
+      job.run();
+      for (int j = 0; j < n; ++j) {
+        for (int k = 0; k < 4; ++k) {
+          ASSERT_EQ(got_r[j][k], want_r[j][k]) << "n " << n << " trial " << trial << " joint " << j;
+        }
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_EQ(got_t[j][k], want_t[j][k]) << "n " << n << " trial " << trial << " joint " << j;
+        }
+      }
+    }
+  }
+}
+
+TEST(SampleBlendJob, ValidateRefusesUnweightedOrMismatchedInputs) {
+  std::mt19937 rng(5);
+  const Clip a = random_clip(4, 3, rng), b = random_clip(4, 3, rng), c = random_clip(5, 3, rng);
+  std::vector<glm::quat> r(5);
+  std::vector<glm::vec3> t(5);
+  SampleBlendJob job;
+  job.a = {&a, 0.0f, 1.0f};
+  job.b = {&b, 0.0f, 1.0f};
+  job.out_rotations = r;
+  job.out_translations = t;
+  EXPECT_TRUE(job.validate());
+  job.b.weight = 0.0f;
+  EXPECT_FALSE(job.validate());
+  job.b = {&c, 0.0f, 1.0f};  // another skeleton
+  EXPECT_FALSE(job.validate());
+  job.b = {nullptr, 0.0f, 1.0f};
+  EXPECT_FALSE(job.validate());
+}
+
 TEST(LocalToModelJob, ChainGeometry) {
   const Skeleton s = make_chain(3, 0.5f);
   std::vector<glm::quat> r(3, glm::quat(1, 0, 0, 0));

@@ -206,6 +206,10 @@ TEST(MinAbsDot, SameAsTheScalarLoop) {
     float expected = 1.0f;
     for (size_t j = 0; j < n; ++j) expected = std::min(expected, std::abs(glm::dot(a[j], b[j])));
     EXPECT_EQ(min_abs_dot(a, b), expected) << n << " joints";
+    // The fused form: the same minimum, and b is a afterwards (every joint, the remainder too).
+    std::vector<glm::quat> kept = b;
+    EXPECT_EQ(min_abs_dot_then_copy(a, kept), expected) << n << " joints";
+    for (size_t j = 0; j < n; ++j) EXPECT_EQ(kept[j], a[j]) << n << " joints, joint " << j;
   }
 }
 
