@@ -75,10 +75,14 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
       }
       return s;
     }
-    case FootLockState::kStepping:
+    case FootLockState::kStepping: {
       // The clips lift the foot before the step is done: it joins their swing from where it is,
       // at the speed it has.
-      return in.hold ? s : release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe, anim_vel);
+      if (in.hold) return s;
+      FootLock out = release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe, anim_vel);
+      out.carry_vel = glm::vec3(out.offset_vel.x, 0.0f, out.offset_vel.z);
+      return out;
+    }
   }
   return s;
 }
@@ -129,11 +133,16 @@ FootLockStep releasing_foot(const FootLock& s, const FootLockInput& in, const Fo
     out.offset.y = y;
     out.offset_vel.y = vy;
   }
-  glm::vec3 goal = in.anim_toe + out.offset * (1.0f - out.shed);
+  critical_spring(out.carry, out.carry_vel, glm::vec3(0.0f), p.release_halflife_s, dt);
+  glm::vec3 goal = in.anim_toe + out.offset * (1.0f - out.shed) + out.carry;
   goal.y = in.anim_toe.y + out.offset.y;
   if (out.shed >= 1.0f) {
+    // Free; what is left of a carried velocity goes on decaying as the free foot's offset (the
+    // same spring), so the foot joins the clip's without a jump.
     out.state = FootLockState::kFree;
-    out.offset = out.offset_vel = glm::vec3(0.0f);
+    out.offset = out.carry;
+    out.offset_vel = out.carry_vel;
+    out.carry = out.carry_vel = glm::vec3(0.0f);
   }
   return {out, goal};
 }
@@ -210,6 +219,7 @@ FootLock release_foot_lock(const FootLock& s, const glm::vec3& drawn_toe,
   out.from = drawn;
   out.offset = drawn - anim;
   out.offset_vel = dv - av;
+  out.carry = out.carry_vel = glm::vec3(0.0f);
   out.shed = out.shed_from = out.shed_goal = out.released_s = out.release_time_s = 0.0f;
   out.swing_from = -1.0f;  // taken from the first frame's progress
   return out;

@@ -17,7 +17,8 @@
 //   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing)
 //   kLocked    -> kStepping   start_foot_step: left too far behind while the other foot is pinned
 //                             and the clips are not walking (their own swing re-places it)
-//   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done
+//   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done (the
+//                             step's velocity is carried on and shed: no jump to the clip's)
 //   kStepping  -> kLocked     the step has landed: pinned at the clip's toe
 //   kReleasing -> kFree       the offset is shed
 //   any        -> kFree       fresh_foot_lock: an agent's first frame
@@ -49,6 +50,11 @@ struct FootLock {
   float released_s = 0.0f;     // releasing: time since the release [s]
   float release_time_s = 0.0f; // releasing: the shortest time to shed the offset in [s]
   float anim_speed = -1.0f;    // the clip's toe speed over the ground last frame [m/s] (< 0: none)
+  // Releasing a step the clips lifted before it was done: the step's own velocity over the ground,
+  // carried on and shed by a critically damped spring (inertialization), so the drawn foot's
+  // velocity does not jump to the clip's [m], and its rate [m/s]. Zero for a pinned foot's release.
+  glm::vec3 carry{0.0f};
+  glm::vec3 carry_vel{0.0f};
 };
 
 struct FootLockInput {

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "mediator/foot_lock.h"
+#include "mediator/springs.h"
 
 namespace gk {
 namespace {
@@ -26,7 +27,8 @@ void expect_defined(const FootLock& s, const char* what) {
   EXPECT_TRUE(s.state == FootLockState::kFree || s.state == FootLockState::kLocked ||
               s.state == FootLockState::kReleasing || s.state == FootLockState::kStepping)
       << what;
-  for (const glm::vec3& v : {s.target, s.offset, s.offset_vel, s.from, s.last_goal, s.goal_vel}) {
+  for (const glm::vec3& v :
+       {s.target, s.offset, s.offset_vel, s.from, s.last_goal, s.goal_vel, s.carry, s.carry_vel}) {
     EXPECT_TRUE(finite(v)) << what;
   }
   for (float x :
@@ -44,6 +46,8 @@ void expect_same(const FootLock& a, const FootLock& b) {
   EXPECT_EQ(a.timer_s, b.timer_s);
   EXPECT_EQ(a.last_goal, b.last_goal);
   EXPECT_EQ(a.goal_vel, b.goal_vel);
+  EXPECT_EQ(a.carry, b.carry);
+  EXPECT_EQ(a.carry_vel, b.carry_vel);
   EXPECT_EQ(a.shed, b.shed);
   EXPECT_EQ(a.swing_from, b.swing_from);
   EXPECT_EQ(a.shed_from, b.shed_from);
@@ -260,10 +264,31 @@ TEST(FootLockTransition, TheClipsLiftingAStepReleasesItFromWhereItIsAtItsSpeed) 
   const FootLockStep next = step_foot_lock(s, in, FootLockParams{}, kDt);
   ASSERT_EQ(next.state.state, FootLockState::kReleasing);
   EXPECT_EQ(next.state.from, glm::vec3(0.1f, 0.05f, 0.0f));
-  // Horizontally nothing is shed on the release's first frame (progress 0): the goal is F.
-  EXPECT_NEAR(next.goal.x, 0.1f, 1e-6f);
+  // Horizontally nothing is shed on the release's first frame (progress 0): the goal is F, plus
+  // the step's own velocity relative to the clip's toe, V - A', carried on (inertialization, not a
+  // jump to the clip's speed) by a critically damped spring from 0: one frame of it is
+  // v0 dt e^{-y dt}.
+  const FootLockParams p;
+  const double v0 = 1.0 - 0.02 / kDt;
+  const double y = 0.5 * halflife_to_damping(p.release_halflife_s);
+  EXPECT_NEAR(next.state.offset_vel.x, v0, 1e-3f);
+  EXPECT_NEAR(next.state.carry_vel.x, v0 * std::exp(-y * kDt) * (1.0 - y * kDt), 1e-3f);
+  EXPECT_NEAR(next.goal.x, 0.1 + v0 * kDt * std::exp(-y * kDt), 1e-5);
   EXPECT_NEAR(next.goal.z, 0.0f, 1e-6f);
-  EXPECT_NEAR(next.state.offset_vel.x, 1.0f - 0.02f / kDt, 1e-3f);
+  // The carried velocity dies out: a second later it is gone.
+  FootLock r = next.state;
+  for (int f = 0; f < 60; ++f) {
+    in = input(a, a, r.last_goal);
+    r = step_foot_lock(r, in, p, kDt).state;
+  }
+  EXPECT_LT(glm::length(r.carry), 1e-4f);
+  EXPECT_LT(glm::length(r.carry_vel), 1e-3f);
+  // A pinned foot's release carries nothing (its drawn foot stood still).
+  const FootLock released = release_foot_lock(locked_at({0.0f, kFloor, 0.0f}),
+                                              {0.0f, kFloor, 0.0f}, glm::vec3(0.0f), a,
+                                              glm::vec3(1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(released.carry, glm::vec3(0.0f));
+  EXPECT_EQ(released.carry_vel, glm::vec3(0.0f));
 }
 
 TEST(FootLockTransition, PinnedFootLeftBehindStepsFromItsPinAndReplantsAtTheClipsToe) {
