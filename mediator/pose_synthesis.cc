@@ -257,8 +257,10 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const int slot = pl.slot_of_agent[i];
       const auto d = detail.empty() ? PoseDetail::kFull : static_cast<PoseDetail>(detail[slot]);
-      // The next agent's pose arrays and clip frames are fetched while this one is posed: its
-      // samples are written straight into its pose, which would otherwise wait for those lines.
+      // The next agent's pose arrays and clip frames are fetched while this one is posed (the
+      // range's first, before it): its samples are written straight into its pose, which would
+      // otherwise wait for those lines.
+      if (i == r.begin()) prefetch_agent(pl, slot, detail);
       if (i + 1 < r.end()) prefetch_agent(pl, pl.slot_of_agent[i + 1], detail);
       if (d == PoseDetail::kHold && !pl.fresh[slot]) {
         hold_agent(pl, slot);
@@ -296,6 +298,9 @@ void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot,
   if (coarse) return;
   prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
   prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
+  // Far agents (kLight) keep no rotation history: max_rotation_change is for the pop metric, which
+  // measures agents near the camera.
+  if (d != PoseDetail::kFull && d != PoseDetail::kNoFootLocks) return;
   prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
   if (d != PoseDetail::kFull) return;
   prefetch_bytes(&locks_.lock[static_cast<size_t>(slot) * 2], 2 * sizeof(FootLock), true);
@@ -429,17 +434,6 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     return;
   }
 
-  // This slot's pose arrays, most likely out of the caches since its last frame: fetched while
-  // the clips are sampled.
-  prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
-  prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
-  prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
-  // Far agents (kLight) keep no rotation history: max_rotation_change is for the pop metric, which
-  // measures agents near the camera, and the history is a cold read and write of J quaternions.
-  if (detail != PoseDetail::kLight) {
-    prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
-  }
-
   // Sample and blend the planned layers.
   sample_layers(pl, slot, /*coarse=*/false, s, local_rot_.data() + base, local_trans_.data() + base,
                 J);
@@ -537,7 +531,6 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
                                   Scratch& s) {
   const size_t K = static_cast<size_t>(coarse_.num_coarse);
   const size_t base = static_cast<size_t>(slot) * num_joints_;
-  prefetch_bytes(world_.data() + base, num_joints_ * sizeof(glm::mat4), true);
   const std::span<glm::quat> rot(s.coarse_rot.data(), K);
   const std::span<glm::vec3> trans(s.coarse_trans.data(), K);
   sample_layers(pl, slot, /*coarse=*/true, s, rot.data(), trans.data(), K);
