@@ -725,7 +725,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       // Overstretched even with the pelvis down and the heel up: the foot steps to where the clip
       // has it while the clip keeps it on the ground, and is let go when the clip lifts it.
       const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
-      const FootLockState other_state = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
+      const FootLockState other_state =
+          locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
       if (!letting_go && pl.plant[side][slot] >= 0.5f && other_state == FootLockState::kLocked) {
         locks_.lock[k] = start_foot_step(locks_.lock[k], drawn);
       } else if (other_state == FootLockState::kStepping) {
