@@ -95,7 +95,18 @@ void screen_bounds(const OrbitCamera& camera, glm::ivec2 viewport, const glm::ve
   }
 }
 
-class RendererTest : public OffscreenRenderTest {};
+class RendererTest : public OffscreenRenderTest {
+ protected:
+  // The two-bone column added as a mesh (its id in *mesh), the camera on it from `distance_m`.
+  void add_column_in_view(float distance_m, int* mesh) {
+    Result<int> m = renderer_->add_mesh(make_two_bone_column());
+    ASSERT_TRUE(m.ok()) << m.message();
+    *mesh = *m;
+    camera_.target = glm::vec3(0.0f, 1.0f, 0.0f);
+    camera_.pitch_rad = 0.1f;
+    camera_.distance_m = distance_m;
+  }
+};
 
 TEST_F(RendererTest, CrowdIsDrawnWhereProjectedAndNowhereElse) {
   const CrowdModel model = make_crowd_model();
@@ -250,12 +261,9 @@ TEST_F(RendererTest, MeshLodDrawsFarAgentsLighterAndKeepsTheCrowdsLook) {
 }
 
 TEST_F(RendererTest, SkinningRotatesSecondJoint) {
-  Result<int> mesh = renderer_->add_mesh(make_two_bone_column());
-  ASSERT_TRUE(mesh.ok()) << mesh.message();
-  camera_.target = glm::vec3(0.0f, 1.0f, 0.0f);
-  camera_.pitch_rad = 0.1f;
-  camera_.distance_m = 6.0f;
-  const AgentDraw agent{glm::vec3(0.0f), glm::vec3(1.0f), *mesh};
+  int mesh = 0;
+  ASSERT_NO_FATAL_FAILURE(add_column_in_view(6.0f, &mesh));
+  const AgentDraw agent{glm::vec3(0.0f), glm::vec3(1.0f), mesh};
   std::vector<glm::mat4> straight(2), bent(2);
   column_palette(agent.position, 0.0f, straight);
   column_palette(agent.position, kPi / 2.0f, bent);
@@ -290,11 +298,8 @@ TEST_F(RendererTest, SkinningRotatesSecondJoint) {
 // An agent's offset moves its whole palette block: a pose made at one place and drawn with the
 // offset to another looks as the same pose made there (a held pose of the crowd's level of detail).
 TEST_F(RendererTest, OffsetDrawsThePaletteWhereTheAgentIsNow) {
-  Result<int> mesh = renderer_->add_mesh(make_two_bone_column());
-  ASSERT_TRUE(mesh.ok()) << mesh.message();
-  camera_.target = glm::vec3(0.0f, 1.0f, 0.0f);
-  camera_.pitch_rad = 0.1f;
-  camera_.distance_m = 8.0f;
+  int mesh = 0;
+  ASSERT_NO_FATAL_FAILURE(add_column_in_view(8.0f, &mesh));
   const glm::vec3 posed_at(-1.5f, 0.0f, 0.0f), now_at(1.5f, 0.0f, 0.5f);
   std::vector<glm::mat4> there(2), here(2);
   column_palette(posed_at, kPi / 4.0f, there);
@@ -302,7 +307,7 @@ TEST_F(RendererTest, OffsetDrawsThePaletteWhereTheAgentIsNow) {
 
   FrameCapture empty, moved, made_here;
   ASSERT_NO_FATAL_FAILURE(render({}, &empty));
-  AgentDraw agent{now_at, glm::vec3(1.0f), *mesh};
+  AgentDraw agent{now_at, glm::vec3(1.0f), mesh};
   agent.offset = now_at - posed_at;
   ASSERT_TRUE(renderer_->upload_palettes(there, 2).ok());
   ASSERT_NO_FATAL_FAILURE(render(std::span(&agent, 1), &moved));
