@@ -497,9 +497,9 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--lod", options->lod,
                 "Level of detail by distance to a focus point: agents planned and posed every "
                 "frame (level 0, full detail) or every 2nd / 4th / 8th frame with fewer details "
-                "(no foot locks; from level 2 no spine twist and no fingers, toes or face "
-                "joints); the metrics then cover level 0 "
-                "agents only (docs/pipeline.md)");
+                "(no new foot locks, those held are let go through their releases; from level "
+                "2 no spine twist and no fingers, toes or face joints); the metrics then cover "
+                "level 0 agents only (docs/pipeline.md)");
   cmd->add_option("--lod-distances", options->lod_distances,
                   "With --lod: level boundaries a,b,c [m] (default 15,30,60)");
   cmd->add_option("--lod-focus", options->lod_focus,

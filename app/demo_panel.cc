@@ -87,9 +87,10 @@ void DemoApp::panel_lod() {
   ImGui::Checkbox("##lod", &lod_.enabled);
   help_marker(
       "Agents far from the camera are planned and posed less often and with less: level 0 every "
-      "frame with everything, 1 every 2nd frame without foot locks, 2 every 4th and 3 every 8th "
-      "also without spine twist. Between updates their phase advances and their body follows the "
-      "simulator. The metrics then cover level 0 agents only. (primary lane; docs/pipeline.md)");
+      "frame with everything, 1 every 2nd frame without new foot locks, 2 every 4th and 3 every "
+      "8th also without spine twist. Between updates their phase advances and their body follows "
+      "the simulator. The metrics then cover level 0 agents only. (primary lane; "
+      "docs/pipeline.md)");
   row("Boundaries [m]");
   float d[3] = {lod_.distances_m[0], lod_.distances_m[1], lod_.distances_m[2]};
   if (ImGui::DragFloat3("##lod_d", d, 0.5f, 0.0f, 1000.0f, "%.1f")) {
