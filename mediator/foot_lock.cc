@@ -79,7 +79,10 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
       // The clips lift the foot before the step is done: it joins their swing from where it is,
       // at the speed it has.
       if (in.hold) return s;
-      FootLock out = release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe, anim_vel);
+      // The offset is taken against where the clip's toe was when the step was last drawn: this
+      // frame the drawn foot then moves on with the step's own velocity (the carry below), not
+      // with that less the clip's (a jolt of a frame, as the clip's foot is lifting fast).
+      FootLock out = release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe_prev, anim_vel);
       out.carry_vel = glm::vec3(out.offset_vel.x, 0.0f, out.offset_vel.z);
       return out;
     }
@@ -126,8 +129,11 @@ FootLockStep releasing_foot(const FootLock& s, const FootLockInput& in, const Fo
   const float by_time = smoothstep01(out.released_s / out.release_time_s);
   out.shed = std::max(out.shed, std::min(out.shed_goal, by_time));
   // Upward the foot follows the clip's lift at once (a spring, so the knee does not snap);
-  // sideways it is corrected over the swing.
-  {
+  // sideways it is corrected over the swing. A foot released above the clip's (a re-planting
+  // step the clips lift) comes down to it over the swing as well: pulled down at once, the knee
+  // would snap straight.
+  const bool above = out.offset.y > 0.0f;
+  if (!above) {
     float y = out.offset.y, vy = out.offset_vel.y;
     critical_spring(y, vy, 0.0f, 0.5f * p.release_halflife_s, dt);
     out.offset.y = y;
@@ -135,7 +141,7 @@ FootLockStep releasing_foot(const FootLock& s, const FootLockInput& in, const Fo
   }
   critical_spring(out.carry, out.carry_vel, glm::vec3(0.0f), p.release_halflife_s, dt);
   glm::vec3 goal = in.anim_toe + out.offset * (1.0f - out.shed) + out.carry;
-  goal.y = in.anim_toe.y + out.offset.y;
+  goal.y = in.anim_toe.y + (above ? out.offset.y * (1.0f - out.shed) : out.offset.y);
   if (out.shed >= 1.0f) {
     // Free; what is left of a carried velocity goes on decaying as the free foot's offset (the
     // same spring), so the foot joins the clip's without a jump.

@@ -264,17 +264,23 @@ TEST(FootLockTransition, TheClipsLiftingAStepReleasesItFromWhereItIsAtItsSpeed) 
   const FootLockStep next = step_foot_lock(s, in, FootLockParams{}, kDt);
   ASSERT_EQ(next.state.state, FootLockState::kReleasing);
   EXPECT_EQ(next.state.from, glm::vec3(0.1f, 0.05f, 0.0f));
-  // Horizontally nothing is shed on the release's first frame (progress 0): the goal is F, plus
-  // the step's own velocity relative to the clip's toe, V - A', carried on (inertialization, not a
-  // jump to the clip's speed) by a critically damped spring from 0: one frame of it is
-  // v0 dt e^{-y dt}.
+  // Horizontally nothing is shed on the release's first frame (progress 0). The offset is taken
+  // from where the clip's toe was when the step was last drawn (A_prev), so this frame the goal
+  // is F plus the clip's toe's move (A - A_prev), plus the step's own velocity relative to the
+  // clip's toe, V - A', carried on (inertialization, not a jump to the clip's speed) by a
+  // critically damped spring from 0: one frame of it is v0 dt e^{-y dt}.
   const FootLockParams p;
   const double v0 = 1.0 - 0.02 / kDt;
   const double y = 0.5 * halflife_to_damping(p.release_halflife_s);
+  EXPECT_NEAR(next.state.offset.x, 0.1 - 0.28, 1e-6);
   EXPECT_NEAR(next.state.offset_vel.x, v0, 1e-3f);
   EXPECT_NEAR(next.state.carry_vel.x, v0 * std::exp(-y * kDt) * (1.0 - y * kDt), 1e-3f);
-  EXPECT_NEAR(next.goal.x, 0.1 + v0 * kDt * std::exp(-y * kDt), 1e-5);
+  EXPECT_NEAR(next.goal.x, 0.1 + 0.02 + v0 * kDt * std::exp(-y * kDt), 1e-5);
   EXPECT_NEAR(next.goal.z, 0.0f, 1e-6f);
+  // So the drawn foot goes on at about the step's own speed V (the spring's first frame takes a
+  // little of the difference off), neither stopping nor jumping to the clip's 1.2 m/s.
+  const double moved = (next.goal.x - 0.1) / kDt;
+  EXPECT_NEAR(moved, 1.0, 0.1);
   // The carried velocity dies out: a second later it is gone.
   FootLock r = next.state;
   for (int f = 0; f < 60; ++f) {
