@@ -204,9 +204,39 @@ FootTracks foot_tracks(const Clip& c, const Skeleton& sk) {
   return t;
 }
 
+// How fast the in-place clip's planted balls are carried backward under the body [m/s]: the
+// median, over the frames a lock may start on (the ball at rest), of the toe's speed along the
+// travel direction (a median: the frames where the ball comes to rest or starts to roll off count
+// for little). The speed at which its feet stand still on the ground: a clean capture's is
+// its root speed; a retargeted take whose feet slide in its own root motion has another, and the
+// pinned feet follow this one. 0 without such frames.
+float stance_sweep_speed(const LocomotionClip& lc, const Skeleton& sk);
+
 // The in-place clip's feet move backward under the body at this velocity: added back, they stand.
 glm::vec3 travel_velocity(const LocomotionClip& lc) {
   return lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
+}
+
+float stance_sweep_speed(const LocomotionClip& lc, const Skeleton& sk) {
+  const Clip& c = lc.clip;
+  const int n = c.num_frames;
+  if (n < 3) return 0.0f;
+  const FootTracks tracks = foot_tracks(c, sk);
+  const glm::vec3 dir(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
+  std::vector<float> sweep;
+  for (int s = 0; s < 2; ++s) {
+    for (int f = 0; f < n; ++f) {
+      if (!lc.plant[s][f]) continue;
+      // Centred difference; across a loop's wrap the frames are a frame apart as anywhere else.
+      const int a = f > 0 ? f - 1 : (c.loops ? n - 1 : f);
+      const int b = f + 1 < n ? f + 1 : (c.loops ? 0 : f);
+      const int frames = (b - a + n) % n;
+      if (frames == 0) continue;
+      sweep.push_back(-glm::dot(tracks.toe[s][b] - tracks.toe[s][a], dir) * c.fps /
+                      static_cast<float>(frames));
+    }
+  }
+  return sweep.empty() ? 0.0f : percentile(std::move(sweep), 0.5);
 }
 
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
@@ -867,6 +897,15 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       return leave_out(lc.clip, "travels at " + std::string(speed) + " but " + no_contacts);
     }
     lc.gait = true;
+    // A take with root motion travels at its root's speed; its planted feet may not keep to it
+    // (a retargeted capture's slide in its own root motion). The mediator plays a clip at the
+    // speed its feet stand still at: a foot pinned where the clip plants it then stays under the
+    // clip's foot through the stance, and the leg is not stretched past its reach by the stance's
+    // end. (A clip authored in place has its speed from its stance foot already.)
+    if (!lc.analysis.in_place) {
+      const float sweep = stance_sweep_speed(lc, sk);
+      if (sweep > kMinGaitSpeed) lc.speed_m_s = sweep;
+    }
     lc.cycle_start_s = lc.analysis.contacts[0][0].start_s;
     if (!lc.clip.loops) lc.cycle_start_s = lc.analysis.cycle.start_s;
     if (!build_phase_table(&lc)) {

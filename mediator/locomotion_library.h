@@ -24,7 +24,9 @@ struct LocomotionClip {
   // clip authored in place): what the metrics' clip references and floors play.
   Clip source;
   ClipAnalysis analysis;       // of the original (retargeted) clip
-  float speed_m_s = 0.0f;      // native ground speed
+  // Native ground speed: for a gait clip with root motion, the speed its planted feet are carried
+  // under the body at (clip analysis reports the root's; a retargeted take's feet may slide).
+  float speed_m_s = 0.0f;
   float direction_rad = 0.0f;  // travel direction relative to facing (0 forward, +pi/2 left)
   bool gait = false;           // has a gait cycle (alternating contacts) and travels
   float cycle_start_s = 0.0f;

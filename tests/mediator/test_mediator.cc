@@ -68,7 +68,7 @@ TEST(Mediator, BelowTheSlowestClipCadenceAndStrideShareTheSlowing) {
   const int slow = lib.groups[lib.forward_group].clips.front();
   const float first = lib.clips[slow].speed_m_s;
   std::vector<float> w(lib.clips.size());
-  for (const float x : {0.9f, 0.64f, 0.5f, 0.3f, 0.1f}) {
+  for (const float x : {0.9f, 0.64f, 0.5f, 0.3f, 0.15f}) {
     choose_clip_weights(lib, p, x * first, 0.0f, w);
     const float gait = w[slow];
     EXPECT_NEAR(gait + w[lib.idle], 1.0f, 1e-5f) << x;
