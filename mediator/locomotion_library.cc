@@ -204,6 +204,29 @@ FootTracks foot_tracks(const Clip& c, const Skeleton& sk) {
   return t;
 }
 
+// A take's contacts within the stride cut from it (frames `first`..`first + frames`), in the
+// loop's time: clip analysis of the whole take sees each stance with what comes before and after
+// it; the loop analysed alone does not (a stride that slows down walks at no one speed, and its
+// stance feet seem to move against the loop's mean travel). A stance that runs through the loop's
+// end goes on at its start: one interval past the duration, as clip analysis gives a loop's.
+std::array<std::vector<TimeInterval>, 2> stride_contacts(const ClipAnalysis& take, int first,
+                                                         int frames, float fps) {
+  std::array<std::vector<TimeInterval>, 2> out;
+  const float from = first / fps, duration = frames / fps, tol = 0.5f / fps;
+  for (int s = 0; s < 2; ++s) {
+    for (const TimeInterval& c : take.contacts[s]) {
+      const float a = std::max(c.start_s - from, 0.0f), b = std::min(c.end_s - from, duration);
+      if (b - a >= 1.0f / fps) out[s].push_back({a, b});
+    }
+    std::vector<TimeInterval>& v = out[s];
+    if (v.size() >= 2 && v.front().start_s <= tol && v.back().end_s >= duration - tol) {
+      v.back().end_s = duration + v.front().end_s;
+      v.erase(v.begin());
+    }
+  }
+  return out;
+}
+
 // How fast the in-place clip's planted balls are carried backward under the body [m/s]: the
 // median, over the frames a lock may start on (the ball at rest), of the toe's speed along the
 // travel direction (a median: the frames where the ball comes to rest or starts to roll off count
@@ -864,9 +887,14 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   // One clip of the library: analysed, made in place, classified as gait or standing.
   // `take`: the capture it was cut from, on a level floor (the metrics' reference; null for a
   // clip authored in place or a second cut of the same take).
-  auto add = [&](Clip c, const Clip* take) {
+  auto add = [&](Clip c, const Clip* take,
+                 const std::array<std::vector<TimeInterval>, 2>* contacts = nullptr) {
     LocomotionClip lc;
     lc.analysis = analyze_clip(c, sk);
+    if (contacts != nullptr) {
+      lc.analysis.contacts[0] = (*contacts)[0];
+      lc.analysis.contacts[1] = (*contacts)[1];
+    }
     const float facing = clip_facing(c, sk);
     lc.speed_m_s = lc.analysis.native_speed_m_s;
     lc.direction_rad = lc.analysis.direction_rad;
@@ -953,16 +981,22 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       const TakeSegmentation seg = segment_take(clip, sk, levelled);
       TakeReport report{clip.name, seg, {}};
       for (size_t k = 0; k < seg.cycles.size(); ++k) {
-        Clip loop = extract_cycle(clip, sk, levelled, seg.strides[seg.cycles[k]]);
+        const Stride& stride = seg.strides[seg.cycles[k]];
+        Clip loop = extract_cycle(clip, sk, levelled, stride);
         if (k > 0) loop.name += " #" + std::to_string(k + 1);
         if (seg.fallback_cycle) {
           // A stride that speeds up or slows down walks at no one speed: only for a library
-          // without any steady cycle.
+          // without any steady cycle. (Analysed as a loop of its own: where that finds its
+          // contacts doubtful, it is played without foot locks.)
           fallbacks.push_back({std::move(loop), clip});
           continue;
         }
+        // A steady cycle keeps the contacts the take's analysis found in its stride.
+        const int first = std::clamp(static_cast<int>(std::lround(stride.span.start_s * clip.fps)),
+                                     0, clip.num_frames - 1);
+        const auto contacts = stride_contacts(levelled, first, loop.num_frames, clip.fps);
         report.clips.push_back(loop.name);
-        add(std::move(loop), k == 0 ? &clip : nullptr);
+        add(std::move(loop), k == 0 ? &clip : nullptr, &contacts);
       }
       for (const TakeSegment& s : seg.segments) {
         if (s.kind != SegmentKind::kIdle || s.span.end_s - s.span.start_s < 0.2f) continue;

@@ -140,6 +140,39 @@ TEST(LocomotionLibrary, MannequinGlbKeepsLocomotionAndItsIdle) {
   ASSERT_TRUE(lib->mesh);  // the glb's own skinned mesh is kept for the renderer
 }
 
+// A steady cycle cut from a take keeps the contacts the take's analysis found in that stride
+// (the loop alone has no before and after for its stances): in each walk of the subject-16 set,
+// the loop's contacts alternate, one stance per foot, each foot down for about the same share of
+// the cycle, a walk's 55-75% (GAIT.md: stance 60%, longer when slow), and both down together for
+// a while twice (double support).
+TEST(LocomotionLibrary, LoopsCutFromATakeKeepItsStances) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
+  for (const char* file : {"clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_11_walk_veer_left.bvh"}) {
+    auto lib = test::load_data_library({file});
+    ASSERT_TRUE(lib.ok()) << lib.message();
+    int loops = 0;
+    for (const LocomotionClip& c : lib->clips) {
+      if (!c.gait) continue;
+      ++loops;
+      const float cycle = c.clip.duration_s();
+      float down[2] = {0.0f, 0.0f};
+      for (int s = 0; s < 2; ++s) {
+        ASSERT_EQ(c.analysis.contacts[s].size(), 1u) << c.clip.name << " side " << s;
+        const TimeInterval& iv = c.analysis.contacts[s][0];
+        down[s] = (iv.end_s - iv.start_s) / cycle;
+        EXPECT_GT(down[s], 0.55f) << c.clip.name << " side " << s;
+        EXPECT_LT(down[s], 0.75f) << c.clip.name << " side " << s;
+      }
+      EXPECT_NEAR(down[0], down[1], 0.1f) << c.clip.name;
+      EXPECT_TRUE(c.double_support) << c.clip.name;
+      EXPECT_TRUE(c.doubts.empty()) << c.clip.name;
+    }
+    EXPECT_GE(loops, 1) << file;
+  }
+}
+
 // Retargeting between skeletons whose rest poses differ (the MRL subject-16 skeleton has its arms
 // along the body, the cgspeed one out to the sides): every retargeted bone points where the
 // source bone points, frame by frame, in model space (upper arms, forearms, thighs, shins).
