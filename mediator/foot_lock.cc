@@ -56,10 +56,13 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
     case FootLockState::kReleasing: {
       // The clips plant the foot while its ball may still roll down and forward off the heel
       // (and a blend of clips lands a foot over a few frames): it is pinned once the ball has come
-      // to rest over the ground, or has stopped slowing down, where it was drawn last frame.
+      // to rest over the ground, or has stopped slowing down, where it was drawn last frame; and
+      // at once if the other foot is not pinned: off the ground, it leaves this one the weight,
+      // and a foot that carries the weight does not move over the ground.
       const bool at_rest =
           in.fresh || speed <= in.still_speed_m_s || (last_speed >= 0.0f && speed >= last_speed);
-      return in.plant && at_rest ? plant_foot(s, in) : s;
+      const bool carries_weight = !in.other_locked;
+      return in.plant && (at_rest || carries_weight) ? plant_foot(s, in) : s;
     }
     case FootLockState::kLocked: {
       const FootLock pinned = lower_pin(s, in);

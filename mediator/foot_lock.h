@@ -12,7 +12,8 @@
 // step). A pinned foot left far behind by a turn or a drift re-plants (start_foot_step), while the
 // other foot is pinned, with a short step as high as the clips' own swing.
 //
-//   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest
+//   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest, or
+//                             the other foot is not pinned (this one takes the weight)
 //   kReleasing -> kLocked     plant_foot: planted again before the offset was shed
 //   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing)
 //   kLocked    -> kStepping   start_foot_step: left too far behind while the other foot is pinned
@@ -65,7 +66,9 @@ struct FootLockInput {
   bool plant = false;              // the clips put this foot on the ground (a lock may start)
   bool hold = false;               // the clips still have weight on it (a lock is kept)
   float swing_progress = 0.0f;     // the clips' swing of this foot, 0 at lift-off, 1 at landing
-  bool other_locked = false;       // the other foot is pinned (one foot steps at a time)
+  // The other foot is pinned (one foot steps at a time; a planted foot is pinned at once when the
+  // other is not: it carries the weight).
+  bool other_locked = false;
   // The gait clips are walking (they vote the feet): this foot's own swing comes soon and carries
   // it back to the clip's foot, so a drift alone starts no re-planting step (a step would lift it
   // while the other foot may still be rolling down onto its ball: both off the ground).

@@ -84,13 +84,14 @@ TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
   Foot foot;
   float x = 0.0f;
   foot.step({x, 0.03f, 0.0f}, false, false, 0.9f, false, still);
-  // Decelerating 4, 3, 2, 1.2, 0.8, 0.4 m/s with the plant on from the first of these frames.
+  // Decelerating 4, 3, 2, 1.2, 0.8, 0.4 m/s with the plant on from the first of these frames,
+  // the other foot pinned (it bears the weight meanwhile).
   const float speeds[] = {4.0f, 3.0f, 2.0f, 1.2f, 0.8f, 0.4f};
   float drawn_before = 0.0f;
   for (float v : speeds) {
     drawn_before = foot.goal.x;
     x += v * kDt;
-    foot.step({x, kFloor, 0.0f}, true, true, 0.0f, false, still);
+    foot.step({x, kFloor, 0.0f}, true, true, 0.0f, true, still);
     if (v > still) {
       EXPECT_NE(foot.lock.state, FootLockState::kLocked) << v;
       EXPECT_FLOAT_EQ(foot.goal.x, x) << "a foot not yet pinned is where the clip has it";
@@ -99,7 +100,7 @@ TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
   ASSERT_EQ(foot.lock.state, FootLockState::kLocked);
   EXPECT_FLOAT_EQ(foot.goal.x, drawn_before);
   // Pinned: the clip's toe creeps on, the drawn one stays.
-  for (int f = 0; f < 10; ++f) foot.step({x += 0.001f, kFloor, 0.0f}, true, true, 0.0f, false, still);
+  for (int f = 0; f < 10; ++f) foot.step({x += 0.001f, kFloor, 0.0f}, true, true, 0.0f, true, still);
   EXPECT_FLOAT_EQ(foot.goal.x, drawn_before);
 
   // A ball that never gets slower than the still speed (the crowd walks faster than the clip) is
@@ -111,7 +112,7 @@ TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
   int locked_at = -1;
   for (int i = 0; i < 4; ++i) {
     x += slowing[i] * kDt;
-    fast.step({x, kFloor, 0.0f}, true, true, 0.0f, false, still);
+    fast.step({x, kFloor, 0.0f}, true, true, 0.0f, true, still);
     if (locked_at < 0 && fast.lock.state == FootLockState::kLocked) locked_at = i;
   }
   EXPECT_EQ(locked_at, 3);

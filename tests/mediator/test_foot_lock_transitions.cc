@@ -186,12 +186,23 @@ TEST(FootLockTransition, ReleasingFootReplantsAtTheDrawnPositionAndSettles) {
   EXPECT_NEAR(next.goal.y, 0.03 + settled(0.01, p.release_halflife_s, kDt), 1e-6);
   EXPECT_GT(next.goal.y, 0.03f + 0.009f) << "settles over frames, not at once";
 
-  // Not at rest (the ball still slows down: 3 m/s after 4 m/s), nothing changes state.
+  // Not at rest (the ball still slows down: 3 m/s after 4 m/s) while the other foot is pinned,
+  // nothing changes state.
   FootLock rolling = s;
   rolling.anim_speed = 4.0f;
   FootLockInput fast = input(anim, anim - glm::vec3(3.0f * kDt, 0.0f, 0.0f), drawn);
   fast.plant = fast.hold = true;
   fast.still_speed_m_s = 0.5f;
+  fast.other_locked = true;
+  EXPECT_EQ(step_foot_lock(rolling, fast, p, kDt).state.state, FootLockState::kReleasing);
+  // The same with the other foot off the ground: this one carries the weight, and is pinned
+  // where it was drawn at once.
+  fast.other_locked = false;
+  const FootLockStep weight = step_foot_lock(rolling, fast, p, kDt);
+  ASSERT_EQ(weight.state.state, FootLockState::kLocked);
+  EXPECT_EQ(weight.state.target, glm::vec3(0.15f, 0.03f, 0.05f));
+  // Not planted by the clips, it is not pinned whatever the other foot does.
+  fast.plant = fast.hold = false;
   EXPECT_EQ(step_foot_lock(rolling, fast, p, kDt).state.state, FootLockState::kReleasing);
 }
 
