@@ -67,8 +67,14 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
     case FootLockState::kLocked: {
       const FootLock pinned = lower_pin(s, in);
       if (!in.hold && !in.other_landing) {
-        return release_foot_lock(pinned, pinned.target + pinned.offset, glm::vec3(0.0f),
-                                 in.anim_toe, anim_vel);
+        // Released from rest: the offset is taken against where the clip's toe was last frame,
+        // and the foot's rest against the clip's speed is carried on and shed (inertialization),
+        // so the drawn foot sets off from rest: taking the clip's lift-off speed at once, the
+        // knee of a leg stretched to its pin would snap.
+        FootLock out = release_foot_lock(pinned, pinned.target + pinned.offset, glm::vec3(0.0f),
+                                         in.anim_toe_prev, anim_vel);
+        out.carry_vel = glm::vec3(out.offset_vel.x, 0.0f, out.offset_vel.z);
+        return out;
       }
       // A foot left behind by a turn or a drift while the clips stand re-plants with a short step,
       // one foot at a time (walking, its own swing comes and takes the offset).
@@ -142,12 +148,12 @@ FootLockStep releasing_foot(const FootLock& s, const FootLockInput& in, const Fo
     out.offset.y = y;
     out.offset_vel.y = vy;
   }
-  critical_spring(out.carry, out.carry_vel, glm::vec3(0.0f), p.release_halflife_s, dt);
+  critical_spring(out.carry, out.carry_vel, glm::vec3(0.0f), p.carry_halflife_s, dt);
   glm::vec3 goal = in.anim_toe + out.offset * (1.0f - out.shed) + out.carry;
   goal.y = in.anim_toe.y + (above ? out.offset.y * (1.0f - out.shed) : out.offset.y);
   if (out.shed >= 1.0f) {
-    // Free; what is left of a carried velocity goes on decaying as the free foot's offset (the
-    // same spring), so the foot joins the clip's without a jump.
+    // Free; what is left of a carried velocity goes on decaying as the free foot's offset, so the
+    // foot joins the clip's without a jump.
     out.state = FootLockState::kFree;
     out.offset = out.carry;
     out.offset_vel = out.carry_vel;

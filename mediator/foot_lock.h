@@ -15,7 +15,8 @@
 //   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest, or
 //                             the other foot is not pinned (this one takes the weight)
 //   kReleasing -> kLocked     plant_foot: planted again before the offset was shed
-//   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing)
+//   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing);
+//                             it sets off from rest (its rest carried on and shed)
 //   kLocked    -> kStepping   start_foot_step: left too far behind while the other foot is pinned
 //                             and the clips are not walking (their own swing re-places it)
 //   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done (the
@@ -51,9 +52,9 @@ struct FootLock {
   float released_s = 0.0f;     // releasing: time since the release [s]
   float release_time_s = 0.0f; // releasing: the shortest time to shed the offset in [s]
   float anim_speed = -1.0f;    // the clip's toe speed over the ground last frame [m/s] (< 0: none)
-  // Releasing a step the clips lifted before it was done: the step's own velocity over the ground,
-  // carried on and shed by a critically damped spring (inertialization), so the drawn foot's
-  // velocity does not jump to the clip's [m], and its rate [m/s]. Zero for a pinned foot's release.
+  // Releasing: the foot's own velocity over the ground (a pinned foot's rest, or a step's speed)
+  // against the clip's, carried on and shed by a critically damped spring (inertialization), so
+  // the drawn foot's velocity does not jump to the clip's [m], and its rate [m/s].
   glm::vec3 carry{0.0f};
   glm::vec3 carry_vel{0.0f};
 };
@@ -94,6 +95,9 @@ struct FootLockParams {
   // [m/s] the clips' own peak swing speed: a released foot is never carried faster than this
   // toward the clip's foot (a long offset takes longer to shed; <= 0: no limit).
   float swing_speed_m_s = 0.0f;
+  // [s] halflife of a released foot's carried velocity (its rest, or a step's speed, against the
+  // clip's): the lock's whole release time, so the foot picks up the clip's swing over it.
+  float carry_halflife_s = 0.12f;
 };
 
 // One frame of one foot: its next state and where its toe should be drawn (world, before any

@@ -197,19 +197,31 @@ TEST(FootLock, ReleaseMovesContinuouslyAndReachesTheClipsToeAtLanding) {
     const glm::vec3 g = foot.step(a, false, false, k / 29.0f);
     if (k == 0) {
       EXPECT_EQ(foot.lock.state, FootLockState::kReleasing);
-      EXPECT_NEAR(horizontal(g, prev), 0.0f, 1e-6f) << "the release starts where it was pinned";
+      EXPECT_LT(horizontal(g, prev), 0.5f * horizontal(a, prev_anim))
+          << "the release sets off from rest, not at the clip's speed";
     }
-    EXPECT_LE(horizontal(g, prev), horizontal(a, prev_anim) + 1.5f * off_xz / 29.0f + 1e-5f) << k;
+    // The clip's own step, the shed's (at most 1.5 * 0.22 / 29 m), and the carried rest's
+    // catching up (a critically damped spring overshoots by at most e^-2 of its start speed).
+    EXPECT_LE(horizontal(g, prev), horizontal(a, prev_anim) + 1.5f * off_xz / 29.0f +
+                                       0.14f * horizontal(a, prev_anim) + 1e-5f)
+        << k;
     EXPECT_LE(std::abs((g.y - prev.y) - (a.y - prev_anim.y)), 0.005f) << k;
     prev = g;
     prev_anim = a;
   }
-  // Progress 1: the clip's toe, and free.
-  EXPECT_NEAR(horizontal(prev, swing_toe(29)), 0.0f, 1e-5f);
+  // Progress 1: the clip's toe, and free, but for what is left of the rest it set off from: the
+  // carried 1.2 m/s (the clip's step) on a critically damped spring of lock_release_s's halflife,
+  // v0 t e^{-y t} after the release's 30 frames (about 2 mm), which goes on decaying as the free
+  // foot's offset: no jump as it turns free.
+  const FootLockParams fp;
+  const double y = 2.0 * std::log(2.0) / fp.carry_halflife_s, t = 30.0 * kDt;
+  const double left = 1.2 * t * std::exp(-y * t);
+  EXPECT_NEAR(horizontal(prev, swing_toe(29)), left, 1e-4);
   EXPECT_NEAR(prev.y, swing_toe(29).y, 1e-4f);
   EXPECT_EQ(foot.lock.state, FootLockState::kFree);
   const glm::vec3 after = foot.step(swing_toe(30), false, false, 0.0f);
-  EXPECT_NEAR(glm::length(after - swing_toe(30)), 0.0f, 1e-5f);
+  EXPECT_LT(glm::length(after - swing_toe(30)), left);
+  EXPECT_LT(horizontal(after, prev), horizontal(swing_toe(30), swing_toe(29)) + 0.001f);
 }
 
 TEST(FootLock, ReleasedAboveAVerticallyStillClipToeStillLandsOnIt) {
@@ -232,7 +244,12 @@ TEST(FootLock, ReleasedAboveAVerticallyStillClipToeStillLandsOnIt) {
   };
   for (int k = 0; k <= 20; ++k) foot.step(swing_toe(k), false, false, k / 20.0f);
   EXPECT_NEAR(foot.goal.y, swing_toe(20).y, 1e-3f);
-  EXPECT_NEAR(horizontal(foot.goal, swing_toe(20)), 0.0f, 1e-5f);
+  // Horizontally at the clip's toe but for what is left of the rest it set off from (the clip's
+  // 3 m/s carried on a critically damped spring, v0 t e^{-y t} after 21 frames: about 2 cm; it
+  // goes on decaying as the free foot's offset).
+  const FootLockParams fp;
+  const double y = 2.0 * std::log(2.0) / fp.carry_halflife_s, t = 21.0 * kDt;
+  EXPECT_NEAR(horizontal(foot.goal, swing_toe(20)), 3.0 * t * std::exp(-y * t), 1e-3);
   const glm::vec3 landed = foot.goal;
   const glm::vec3 next = foot.step(swing_toe(20), false, false, 0.0f);
   EXPECT_NEAR(std::max(next.y, kFloor), std::max(landed.y, kFloor), 1e-3f);
@@ -307,9 +324,10 @@ TEST(FootLock, StepBecomesAReleaseWhenTheClipsLiftTheFoot) {
     foot.step(a, false, false, k == 10 ? 1.0f : 0.3f + 0.07f * k);  // lands at progress 1
   }
   EXPECT_EQ(foot.lock.state, FootLockState::kFree);
-  // At the clip's toe but for what is left of the step's carried velocity (a few mm after ten
-  // frames of a 0.06 s halflife), which keeps decaying there: no jump when it turns free.
-  EXPECT_LT(horizontal(foot.goal, a), 0.005f);
+  // At the clip's toe but for what is left of the step's carried velocity (about a centimetre
+  // after ten frames of lock_release_s's halflife), which keeps decaying there: no jump when it
+  // turns free.
+  EXPECT_LT(horizontal(foot.goal, a), 0.015f);
   const float left = horizontal(foot.goal, a);
   for (int k = 0; k < 60; ++k) foot.step(a, false, false, 1.0f);
   EXPECT_LT(horizontal(foot.goal, a), 0.01f * left + 1e-5f);
