@@ -71,10 +71,8 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
         // and the foot's rest against the clip's speed is carried on and shed (inertialization),
         // so the drawn foot sets off from rest: taking the clip's lift-off speed at once, the
         // knee of a leg stretched to its pin would snap.
-        FootLock out = release_foot_lock(pinned, pinned.target + pinned.offset, glm::vec3(0.0f),
-                                         in.anim_toe_prev, anim_vel);
-        out.carry_vel = glm::vec3(out.offset_vel.x, 0.0f, out.offset_vel.z);
-        return out;
+        return release_foot_lock(pinned, pinned.target + pinned.offset, glm::vec3(0.0f),
+                                 in.anim_toe_prev, anim_vel);
       }
       // A foot left behind by a turn or a drift while the clips stand re-plants with a short step,
       // one foot at a time (walking, its own swing comes and takes the offset).
@@ -89,11 +87,9 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
       // at the speed it has.
       if (in.hold) return s;
       // The offset is taken against where the clip's toe was when the step was last drawn: this
-      // frame the drawn foot then moves on with the step's own velocity (the carry below), not
+      // frame the drawn foot then moves on with the step's own velocity (carried on), not
       // with that less the clip's (a jolt of a frame, as the clip's foot is lifting fast).
-      FootLock out = release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe_prev, anim_vel);
-      out.carry_vel = glm::vec3(out.offset_vel.x, 0.0f, out.offset_vel.z);
-      return out;
+      return release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe_prev, anim_vel);
     }
   }
   return s;
@@ -234,7 +230,8 @@ FootLock release_foot_lock(const FootLock& s, const glm::vec3& drawn_toe,
   out.from = drawn;
   out.offset = drawn - anim;
   out.offset_vel = dv - av;
-  out.carry = out.carry_vel = glm::vec3(0.0f);
+  out.carry = glm::vec3(0.0f);
+  out.carry_vel = glm::vec3(out.offset_vel.x, 0.0f, out.offset_vel.z);
   out.shed = out.shed_from = out.shed_goal = out.released_s = out.release_time_s = 0.0f;
   out.swing_from = -1.0f;  // taken from the first frame's progress
   return out;

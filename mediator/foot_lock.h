@@ -130,8 +130,11 @@ FootLock plant_foot(const FootLock& state, const FootLockInput& in);
 FootLock start_foot_step(const FootLock& state, const glm::vec3& from);
 
 // Lets a pinned or stepping foot go from where it is drawn (drawn_toe, moving at drawn_vel) to the
-// clip's toe (anim_toe, moving at anim_vel) through an inertialization offset. Unusable values
-// count as: the last goal for drawn_toe, drawn_toe for anim_toe, no speed for the velocities.
+// clip's toe (anim_toe, moving at anim_vel) through an inertialization offset: the offset is shed
+// over the swing, and the horizontal velocity difference drawn_vel - anim_vel is carried on and
+// shed (`carry`), so the drawn foot keeps its own speed at first. Pass the clip's toe of the frame
+// the foot was last drawn, so that this frame moves on from there. Unusable values count as: the
+// last goal for drawn_toe, drawn_toe for anim_toe, no speed for the velocities.
 FootLock release_foot_lock(const FootLock& state, const glm::vec3& drawn_toe,
                            const glm::vec3& drawn_vel, const glm::vec3& anim_toe,
                            const glm::vec3& anim_vel);

@@ -735,7 +735,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
         repin[side] = true;
       } else {
         // Both in the space of the lock's goals (the body before its drop): the offset is what
-        // really separates the drawn toe from the clip's, not the drop as well.
+        // really separates the drawn toe from the clip's, not the drop as well. This frame is
+        // drawn already: the clip's toe now is the one of the frame it was last drawn.
         locks_.lock[k] = release_foot_lock(locks_.lock[k], drawn, glm::vec3(0.0f), anim_toe[side],
                                            anim_vel[side]);
       }
