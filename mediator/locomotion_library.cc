@@ -227,19 +227,17 @@ std::array<std::vector<TimeInterval>, 2> stride_contacts(const ClipAnalysis& tak
   return out;
 }
 
+// The in-place clip's feet move backward under the body at this velocity: added back, they stand.
+glm::vec3 travel_velocity(const LocomotionClip& lc) {
+  return lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
+}
+
 // How fast the in-place clip's planted balls are carried backward under the body [m/s]: the
 // median, over the frames a lock may start on (the ball at rest), of the toe's speed along the
 // travel direction (a median: the frames where the ball comes to rest or starts to roll off count
 // for little). The speed at which its feet stand still on the ground: a clean capture's is
 // its root speed; a retargeted take whose feet slide in its own root motion has another, and the
 // pinned feet follow this one. 0 without such frames.
-float stance_sweep_speed(const LocomotionClip& lc, const Skeleton& sk);
-
-// The in-place clip's feet move backward under the body at this velocity: added back, they stand.
-glm::vec3 travel_velocity(const LocomotionClip& lc) {
-  return lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
-}
-
 float stance_sweep_speed(const LocomotionClip& lc, const Skeleton& sk) {
   const Clip& c = lc.clip;
   const int n = c.num_frames;
