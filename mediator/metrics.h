@@ -6,8 +6,9 @@
 //   - percentiles (p95, p99) come from QuantileSketch: within 0.1% of the exact order statistic
 //     (mediator/quantile_sketch.h);
 //   - each live agent keeps a few frames for its finite differences (heading, jerk, limb
-//     accelerations) and 2 s of its feet for METRICS.md v1's contact band (see
-//     mediator/foot_slide_stream.h for that band's documented error);
+//     accelerations) and 2 s of its feet, to apply the v1 foot-slide metric's own contact
+//     definition (measurement only: no pose or planning code reads it; see
+//     mediator/foot_slide_stream.h for its documented error);
 //   - an agent's track is folded into the totals and released when the agent leaves.
 // docs/metrics.md gives the error of every figure in METRICS.md's terms.
 
@@ -31,8 +32,9 @@ namespace gk {
 struct MetricsReport {
   SlideStats slide;
   int64_t slide_samples = 0;  // the exact count (slide.num_samples saturates at INT_MAX)
-  // METRICS.md v1's contact band: how far above it, at most, a frame counted in contact lay
-  // because its foot went lower more than FootSlideStream::kLag_s later [m]; 0: exact.
+  // The measurement's own error against the v1 foot-slide definition: how far above that
+  // definition's contact height, at most, a frame counted in contact lay because its foot went
+  // lower more than FootSlideStream::kLag_s later [m]; 0: exact. (Reported, never steered by.)
   float slide_toe_band_excess_m = 0.0f;
   float slide_ankle_band_excess_m = 0.0f;
   Summary torsion_deg, facing_error_deg, heading_error_deg, root_error_cm, playback_rate;
