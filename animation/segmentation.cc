@@ -6,6 +6,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "animation/mirror.h"
 #include "animation/pose_jobs.h"
 
 namespace gk {
@@ -150,6 +151,44 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
   }
   std::sort(out.strides.begin(), out.strides.end(),
             [](const Stride& x, const Stride& y) { return x.span.start_s < y.span.start_s; });
+  // Steps: from each contact start of a foot to the other foot's next, with no contact start of
+  // the first foot between them; measured as strides are.
+  for (int s = 0; s < 2; ++s) {
+    for (const TimeInterval& c : a.contacts[s]) {
+      if (!starts_inside(c, fps)) continue;
+      const float t0 = c.start_s;
+      float t1 = -1.0f;
+      for (const TimeInterval& o : a.contacts[1 - s]) {
+        if (o.start_s > t0 && (t1 < 0.0f || o.start_s < t1)) t1 = o.start_s;
+      }
+      if (t1 < 0.0f) continue;
+      bool again = false;
+      for (const TimeInterval& m : a.contacts[s]) again = again || (m.start_s > t0 && m.start_s < t1);
+      const float dur = t1 - t0;
+      if (again || dur < 0.5f * th.min_stride_s || dur > 0.5f * th.max_stride_s) continue;
+      const int f0 = frame_at(t0, fps, n), f1 = frame_at(t1, fps, n);
+      if (f1 - f0 < 2) continue;
+      const int fm = (f0 + f1) / 2;
+      Stride st;
+      st.span = {t0, t1};
+      st.side = s;
+      const glm::vec2 d = tr.hips[f1] - tr.hips[f0];
+      st.speed_m_s = glm::length(d) * fps / (f1 - f0);
+      const float v1 = glm::length(tr.hips[fm] - tr.hips[f0]) * fps / std::max(1, fm - f0);
+      const float v2 = glm::length(tr.hips[f1] - tr.hips[fm]) * fps / std::max(1, f1 - fm);
+      st.speed_change = st.speed_m_s > 1e-3f ? (v2 - v1) / st.speed_m_s : 0.0f;
+      st.turn_rad = tr.facing[f1] - tr.facing[f0];
+      const float mean_facing = 0.5f * (tr.facing[f0] + tr.facing[f1]);
+      st.direction_rad =
+          st.speed_m_s > 1e-3f ? wrap(std::atan2(d.x, d.y) - mean_facing) : 0.0f;
+      st.steady = std::abs(st.speed_change) < th.steady_speed_change &&
+                  std::abs(st.turn_rad) < 0.5f * th.steady_turn_rad && v1 > th.idle_speed_m_s &&
+                  v2 > th.idle_speed_m_s;
+      out.steps.push_back(st);
+    }
+  }
+  std::sort(out.steps.begin(), out.steps.end(),
+            [](const Stride& x, const Stride& y) { return x.span.start_s < y.span.start_s; });
 
   // Per-frame labels: steady where a steady stride covers the frame; idle where the root stands;
   // the rest is told apart per run (start, stop, turn, transition).
@@ -254,22 +293,52 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
     }
     if (seg.cycle >= 0) out.cycles.push_back(seg.cycle);
   }
-  if (out.cycles.empty() && !out.strides.empty()) {
-    int least = 0;
-    for (size_t i = 1; i < out.strides.size(); ++i) {
+  if (out.cycles.empty() && (!out.strides.empty() || !out.steps.empty())) {
+    int least = -1;
+    for (size_t i = 0; i < out.strides.size(); ++i) {
       const Stride& st = out.strides[i];
-      if (std::abs(st.speed_change) < std::abs(out.strides[least].speed_change)) {
+      if (least < 0 || std::abs(st.speed_change) < std::abs(out.strides[least].speed_change)) {
         least = static_cast<int>(i);
       }
     }
-    out.cycles.push_back(least);
+    if (least >= 0) out.cycles.push_back(least);
     out.fallback_cycle = true;
-    char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "no steady stride (the body speeds up, slows down or turns in every one): the "
-                  "least unsteady stride, %.2f-%.2f s (speed change %.0f%%), is the cycle if the library has no steady one",
-                  out.strides[least].span.start_s, out.strides[least].span.end_s,
-                  100.0f * out.strides[least].speed_change);
+    // The steadiest step that walks (both halves faster than standing, a turn no bigger than half
+    // a steady stride's): with its mirror image, a stride of one pace.
+    for (size_t i = 0; i < out.steps.size(); ++i) {
+      const Stride& st = out.steps[i];
+      const int f0 = frame_at(st.span.start_s, fps, n), f1 = frame_at(st.span.end_s, fps, n);
+      const int fm = (f0 + f1) / 2;
+      const float v1 = glm::length(tr.hips[fm] - tr.hips[f0]) * fps / std::max(1, fm - f0);
+      const float v2 = glm::length(tr.hips[f1] - tr.hips[fm]) * fps / std::max(1, f1 - fm);
+      if (v1 <= th.idle_speed_m_s || v2 <= th.idle_speed_m_s ||
+          std::abs(st.turn_rad) >= 0.5f * th.steady_turn_rad) {
+        continue;
+      }
+      if (out.mirror_step < 0 ||
+          std::abs(st.speed_change) < std::abs(out.steps[out.mirror_step].speed_change)) {
+        out.mirror_step = static_cast<int>(i);
+      }
+    }
+    char buf[320];
+    if (out.mirror_step >= 0) {
+      const Stride& st = out.steps[out.mirror_step];
+      std::snprintf(buf, sizeof buf,
+                    "no steady stride (the body speeds up, slows down or turns in every one): the "
+                    "steadiest step, %.2f-%.2f s (%s foot down first, %.2f m/s, speed change "
+                    "%.0f%%), and its mirror image make the cycle if the library has no steady one",
+                    st.span.start_s, st.span.end_s, st.side == 0 ? "left" : "right", st.speed_m_s,
+                    100.0f * st.speed_change);
+    } else if (least >= 0) {
+      std::snprintf(buf, sizeof buf,
+                    "no steady stride (the body speeds up, slows down or turns in every one): the "
+                    "least unsteady stride, %.2f-%.2f s (speed change %.0f%%), is the cycle if the "
+                    "library has no steady one",
+                    out.strides[least].span.start_s, out.strides[least].span.end_s,
+                    100.0f * out.strides[least].speed_change);
+    } else {
+      std::snprintf(buf, sizeof buf, "no stride and no step that walks: no gait cycle can be made");
+    }
     out.problems.push_back(buf);
   }
   if (out.strides.empty()) {
@@ -407,6 +476,154 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
   c.rotations.assign(rot.begin(), rot.begin() + static_cast<size_t>(len) * nj);
   c.translations.assign(tra.begin(), tra.begin() + static_cast<size_t>(len) * nj);
   return c;
+}
+
+MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
+                                     const Stride& step, const std::vector<int16_t>& mirror_map) {
+  MirroredCycle out;
+  const int n = take.num_frames, nj = take.num_joints;
+  const float fps = take.fps;
+  const int a = frame_at(step.span.start_s, fps, n);
+  const int b = frame_at(step.span.end_s, fps, n);
+  const int len = b - a;
+  const int x = step.side, y = 1 - step.side;  // x lands at the step's start, y at its end
+  if (len < 2 || !sk.has_locomotion_roles() || nj != sk.num_joints() ||
+      static_cast<int>(mirror_map.size()) != nj) {
+    out.loop = extract_span(take, step.span);
+    out.loop.loops = true;
+    return out;
+  }
+  // Where each foot leaves the ground within the step, in frames from its start: y, down when x
+  // lands, lifts at lift_y (0: already in the air, as in a run); x lifts at lift_x (len: still
+  // down when y lands, as in a walk).
+  const float tol = 0.5f / fps;
+  int lift_y = 0, lift_x = len;
+  for (const TimeInterval& c : an.contacts[y]) {
+    if (c.start_s <= step.span.start_s + tol && c.end_s >= step.span.start_s - tol) {
+      lift_y = std::clamp(static_cast<int>(std::lround((c.end_s - step.span.start_s) * fps)), 0,
+                          len - 1);
+    }
+  }
+  for (const TimeInterval& c : an.contacts[x]) {
+    if (std::abs(c.start_s - step.span.start_s) <= tol) {
+      lift_x = std::clamp(static_cast<int>(std::lround((c.end_s - step.span.start_s) * fps)), 1,
+                          len);
+    }
+  }
+  // The step, and its mirror image in the vertical plane along its travel (through the middle of
+  // the hips' path: their sway to either side is mirrored onto the other), moved on to where the
+  // step ends.
+  const Clip step_clip = extract_span(take, step.span);  // frames a..b
+  const TakeTrack tr = track_take(step_clip, sk);
+  const float facing = 0.5f * (tr.facing.front() + tr.facing.back());
+  const glm::vec3 lateral(std::cos(facing), 0.0f, -std::sin(facing));
+  const glm::vec2 mid = 0.5f * (tr.hips.front() + tr.hips.back());
+  const Clip mirrored =
+      mirror_clip(step_clip, sk, mirror_map, glm::vec3(mid.x, 0.0f, mid.y), lateral);
+  const TakeTrack mt = track_take(mirrored, sk);
+  const glm::vec2 shift = tr.hips.back() - mt.hips.front();
+  // The two as one take: frames 0..len the step, len..2 len its mirror (its first frame is the
+  // step's last).
+  const int frames = 2 * len + 1;
+  Clip both;
+  both.name = take.name;
+  both.source = take.source;
+  both.fps = fps;
+  both.num_frames = frames;
+  both.num_joints = nj;
+  both.loops = false;
+  both.rotations.assign(step_clip.rotations.begin(), step_clip.rotations.end());
+  both.translations.assign(step_clip.translations.begin(), step_clip.translations.end());
+  for (int k = 1; k <= len; ++k) {
+    for (int j = 0; j < nj; ++j) {
+      const size_t i = static_cast<size_t>(k) * nj + j;
+      glm::vec3 t = mirrored.translations[i];
+      if (sk.parents[j] < 0) t += glm::vec3(shift.x, 0.0f, shift.y);
+      both.rotations.push_back(mirrored.rotations[i]);
+      both.translations.push_back(t);
+    }
+  }
+  auto R = [&](int k, int j) -> glm::quat& {
+    return both.rotations[static_cast<size_t>(k) * nj + j];
+  };
+  auto T = [&](int k, int j) -> glm::vec3& {
+    return both.translations[static_cast<size_t>(k) * nj + j];
+  };
+  // The join at frame len: the step ends as the mirror would begin. y's leg takes its mismatch up
+  // while it swings into its landing (before the join); x's leg while it swings in the mirror
+  // (after it); the rest of the body over the mirrored step.
+  std::vector<int> leg(nj, -1);
+  for (int j = 0; j < nj; ++j) {
+    for (int s = 0; s < 2; ++s) {
+      for (int q = j; q >= 0; q = sk.parents[q]) {
+        if (q == sk.hip(static_cast<Side>(s))) leg[j] = s;
+      }
+    }
+  }
+  auto smooth = [](float u) {
+    u = std::clamp(u, 0.0f, 1.0f);
+    return u * u * (3.0f - 2.0f * u);
+  };
+  for (int j = 0; j < nj; ++j) {
+    const glm::quat at_join = R(len, j);
+    const glm::vec3 at_join_t = T(len, j);
+    const glm::quat mirror_first = mirrored.rotations[static_cast<size_t>(j)];
+    glm::vec3 mirror_first_t = mirrored.translations[static_cast<size_t>(j)];
+    if (sk.parents[j] < 0) mirror_first_t += glm::vec3(shift.x, 0.0f, shift.y);
+    if (leg[j] == y) {
+      glm::quat diff = mirror_first * glm::inverse(at_join);
+      if (diff.w < 0.0f) diff = -diff;
+      const glm::vec3 dt = mirror_first_t - at_join_t;
+      for (int k = lift_y + 1; k <= len; ++k) {
+        const float w = smooth(static_cast<float>(k - lift_y) / static_cast<float>(len - lift_y));
+        R(k, j) = glm::normalize(glm::slerp(glm::quat(1, 0, 0, 0), diff, w) * R(k, j));
+        T(k, j) += w * dt;
+      }
+      continue;
+    }
+    glm::quat diff = at_join * glm::inverse(mirror_first);
+    if (diff.w < 0.0f) diff = -diff;
+    glm::vec3 dt = at_join_t - mirror_first_t;
+    if (sk.parents[j] < 0) dt.x = dt.z = 0.0f;  // the travel is continuous already
+    for (int k = len + 1; k <= 2 * len; ++k) {
+      float w = 1.0f - static_cast<float>(k - len) / static_cast<float>(len);
+      if (leg[j] == x) {
+        const int from = len + lift_y;  // x's swing in the mirror: as y's in the step
+        w = 1.0f - smooth(static_cast<float>(k - from) / static_cast<float>(2 * len - from));
+      }
+      R(k, j) = glm::normalize(glm::slerp(glm::quat(1, 0, 0, 0), diff, w) * R(k, j));
+      T(k, j) += w * dt;
+    }
+  }
+  // Contacts of the two steps (frames): x down from its landing until it lifts in the step, and
+  // again in the mirror as y was in the step; y as x was, in the mirror.
+  ClipAnalysis joined = an;
+  const float f = 1.0f / fps;
+  auto iv = [&](int from, int to) { return TimeInterval{from * f, to * f}; };
+  joined.contacts[x].clear();
+  joined.contacts[y].clear();
+  if (lift_x >= len) {
+    joined.contacts[x].push_back(iv(0, len + lift_y));
+  } else {
+    joined.contacts[x].push_back(iv(0, lift_x));
+    if (lift_y > 0) joined.contacts[x].push_back(iv(len, len + lift_y));
+  }
+  joined.contacts[x].push_back(iv(2 * len, 2 * len));
+  if (lift_y > 0) joined.contacts[y].push_back(iv(0, lift_y));
+  joined.contacts[y].push_back(iv(len, len + lift_x));
+  Stride stride = step;
+  stride.span = {0.0f, 2 * len * f};
+  out.loop = extract_cycle(both, sk, joined, stride);
+  // The loop's contacts: a stance through the loop's end goes on past its duration.
+  out.contacts[x] = {joined.contacts[x][0]};
+  if (lift_x < len && lift_y > 0) out.contacts[x].push_back(iv(len, len + lift_y));
+  if (lift_x >= len) {
+    out.contacts[y] = {iv(len, 2 * len + lift_y)};
+  } else {
+    if (lift_y > 0) out.contacts[y].push_back(iv(0, lift_y));
+    out.contacts[y].push_back(iv(len, len + lift_x));
+  }
+  return out;
 }
 
 Clip extract_span(const Clip& take, TimeInterval span) {

@@ -6,6 +6,7 @@
 // cross-faded with the neighbouring stride, its turn spread out so the loop travels straight):
 // the cycles a blend space is made of. Starts, stops and turns stay available as transitions.
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,12 @@ struct TakeSegmentation {
   // unsteady one (and `problems` says so).
   std::vector<int> cycles;
   bool fallback_cycle = false;  // `cycles` holds the least unsteady stride, not a steady one
+  // Steps: one foot's contact start to the other foot's next (`side`: the first foot), measured
+  // as strides are (their two halves' speeds, turn, direction), sorted by start.
+  std::vector<Stride> steps;
+  // Without a steady stride: the steadiest step (index into steps; -1 if none), which with its
+  // mirror image makes a stride (extract_mirrored_cycle): a stop's or a start's one good step.
+  int mirror_step = -1;
   // What is doubtful or unusable, and why (plain sentences for analyze-clip and the library).
   std::vector<std::string> problems;
 };
@@ -74,6 +81,22 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& skeleton, const 
 // never slides for it), the rest of the body over the whole stride.
 Clip extract_cycle(const Clip& take, const Skeleton& skeleton, const ClipAnalysis& analysis,
                    const Stride& stride);
+
+// A loop made of one step of the take and its mirror image (the other foot's step, as the first
+// foot's was): for a take with no steady stride, where one step is good and the next is not (a
+// stop, a sudden stop). The step is reflected in the vertical plane along its travel, joints
+// exchanged by `mirror_map` (mirror_joint_map), and placed where the step ends; the joins are
+// closed as extract_cycle closes a stride's seam (a leg's mismatch taken up while that foot swings,
+// the body's over the step). `contacts`: each foot's contacts in the loop's time, from the take's
+// contacts of the step (a stance running through the loop's end goes on past its duration, as
+// clip analysis gives a loop's); they alternate by construction.
+struct MirroredCycle {
+  Clip loop;
+  std::array<std::vector<TimeInterval>, 2> contacts;
+};
+MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& skeleton,
+                                     const ClipAnalysis& analysis, const Stride& step,
+                                     const std::vector<int16_t>& mirror_map);
 
 // The take's frames from `span` as a clip that does not loop (a start, a stop, a turn).
 Clip extract_span(const Clip& take, TimeInterval span);

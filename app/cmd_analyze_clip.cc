@@ -16,6 +16,7 @@
 
 #include "animation/analysis.h"
 #include "animation/clip_library.h"
+#include "animation/mirror.h"
 #include "animation/procedural.h"
 #include "animation/segmentation.h"
 #include "app/clip_plot.h"
@@ -66,9 +67,21 @@ nlohmann::json segmentation_json(const TakeSegmentation& seg) {
     if (s.cycle >= 0) j["cycle_stride"] = s.cycle;
     segments.push_back(std::move(j));
   }
+  nlohmann::json steps = nlohmann::json::array();
+  for (const Stride& st : seg.steps) {
+    steps.push_back({{"start_s", st.span.start_s},
+                     {"end_s", st.span.end_s},
+                     {"foot", st.side == 0 ? "left" : "right"},
+                     {"speed_m_s", st.speed_m_s},
+                     {"speed_change", st.speed_change},
+                     {"turn_deg", st.turn_rad * kDeg},
+                     {"steady", st.steady}});
+  }
   return {{"strides", strides},
+          {"steps", steps},
           {"segments", segments},
           {"cycles", seg.cycles},
+          {"mirror_step", seg.mirror_step},
           {"problems", seg.problems}};
 }
 
@@ -146,9 +159,17 @@ void print_text(const nlohmann::json& j) {
   for (const auto& st : strides) steady += st["steady"].get<bool>();
   std::printf("  strides %zu (%d steady)\n", strides.size(), steady);
   for (const auto& l : take["loops"]) {
-    std::printf("  loop of stride %d: %d frames, %.3f m/s, direction %+.1f deg, foot-slide floor %.2f cm/s\n",
-                l["stride"].get<int>(), l["frames"].get<int>(), l["speed_m_s"].get<double>(),
-                l["direction_deg"].get<double>(), l["foot_slide_floor_cm_s"].get<double>());
+    if (l.contains("step")) {
+      std::printf("  loop of step %d and its mirror image: %d frames, %.3f m/s, direction %+.1f "
+                  "deg, foot-slide floor %.2f cm/s\n",
+                  l["step"].get<int>(), l["frames"].get<int>(), l["speed_m_s"].get<double>(),
+                  l["direction_deg"].get<double>(), l["foot_slide_floor_cm_s"].get<double>());
+    } else {
+      std::printf("  loop of stride %d: %d frames, %.3f m/s, direction %+.1f deg, foot-slide "
+                  "floor %.2f cm/s\n",
+                  l["stride"].get<int>(), l["frames"].get<int>(), l["speed_m_s"].get<double>(),
+                  l["direction_deg"].get<double>(), l["foot_slide_floor_cm_s"].get<double>());
+    }
     for (const char* side : {"left", "right"}) {
       std::printf("    contacts %-5s:", side);
       for (const auto& c : l["contacts"][side]) {
@@ -236,7 +257,23 @@ int run_analyze(const AnalyzeOptions& opt) {
       nlohmann::json j = analysis_json(set, clip, a, seg);
       // Each cycle cut out as a loop, analysed as the library will use it.
       nlohmann::json loops = nlohmann::json::array();
+      if (seg.fallback_cycle && seg.mirror_step >= 0) {
+        // The library's cycle: the steadiest step and its mirror image, with the step's contacts.
+        const MirroredCycle mc =
+            extract_mirrored_cycle(clip, *set.skeleton, a, seg.steps[seg.mirror_step],
+                                   mirror_joint_map(*set.skeleton));
+        const ClipAnalysis la = analyze_clip(mc.loop, *set.skeleton);
+        loops.push_back({{"step", seg.mirror_step},
+                         {"frames", mc.loop.num_frames},
+                         {"speed_m_s", la.native_speed_m_s},
+                         {"direction_deg", la.direction_rad * kDeg},
+                         {"contacts",
+                          {{"left", intervals_json(mc.contacts[0])},
+                           {"right", intervals_json(mc.contacts[1])}}},
+                         {"foot_slide_floor_cm_s", la.floor.mean_cm_s}});
+      }
       for (int ci : seg.cycles) {
+        if (seg.fallback_cycle && seg.mirror_step >= 0) break;
         const Clip loop = extract_cycle(clip, *set.skeleton, a, seg.strides[ci]);
         const ClipAnalysis la = analyze_clip(loop, *set.skeleton);
         loops.push_back({{"stride", ci},

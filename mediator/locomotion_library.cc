@@ -10,6 +10,7 @@
 
 #include <glm/gtx/quaternion.hpp>
 
+#include "animation/mirror.h"
 #include "animation/pose_jobs.h"
 #include "animation/segmentation.h"
 #include "common/stats.h"
@@ -875,6 +876,9 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   std::vector<LocomotionClip> idles;
   struct Fallback {
     Clip loop, take;
+    // The loop's contacts where they are known (a step and its mirror image), else analysed.
+    bool has_contacts = false;
+    std::array<std::vector<TimeInterval>, 2> contacts;
   };
   std::vector<Fallback> fallbacks;
   struct PendingTransition {
@@ -882,6 +886,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     TransitionKind kind;
   };
   std::vector<PendingTransition> pending;
+  std::vector<int16_t> mirror_map;  // made when a take needs a mirrored step
   // One clip of the library: analysed, made in place, classified as gait or standing.
   // `take`: the capture it was cut from, on a level floor (the metrics' reference; null for a
   // clip authored in place or a second cut of the same take).
@@ -978,7 +983,17 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       const ClipAnalysis levelled = analyze_clip(clip, sk);
       const TakeSegmentation seg = segment_take(clip, sk, levelled);
       TakeReport report{clip.name, seg, {}};
-      for (size_t k = 0; k < seg.cycles.size(); ++k) {
+      if (seg.fallback_cycle && seg.mirror_step >= 0) {
+        // No steady stride, but a step that walks: it and its mirror image make the cycle (only
+        // for a library without any steady cycle), with the contacts the take has in that step.
+        if (mirror_map.empty()) mirror_map = mirror_joint_map(sk);
+        MirroredCycle mc =
+            extract_mirrored_cycle(clip, sk, levelled, seg.steps[seg.mirror_step], mirror_map);
+        Fallback fb{std::move(mc.loop), clip, true, std::move(mc.contacts)};
+        fallbacks.push_back(std::move(fb));
+      }
+      for (size_t k = 0; k < seg.cycles.size() && !(seg.fallback_cycle && seg.mirror_step >= 0);
+           ++k) {
         const Stride& stride = seg.strides[seg.cycles[k]];
         Clip loop = extract_cycle(clip, sk, levelled, stride);
         if (k > 0) loop.name += " #" + std::to_string(k + 1);
@@ -1032,17 +1047,22 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         report.clips.push_back(cut.name);
         pending.push_back({std::move(cut), start ? TransitionKind::kStart : TransitionKind::kStop});
       }
-      if (report.clips.empty() && seg.cycles.empty()) {
+      if (report.clips.empty() && seg.cycles.empty() && seg.mirror_step < 0) {
         leave_out(clip, "a take with no stride to loop and no standing stretch (see its segments)");
       }
       lib.takes.push_back(std::move(report));
     }
   }
   if (lib.clips.empty()) {
-    for (Fallback& f : fallbacks) add(std::move(f.loop), &f.take);
+    for (Fallback& f : fallbacks) {
+      add(std::move(f.loop), &f.take, f.has_contacts ? &f.contacts : nullptr);
+    }
   } else {
     for (const Fallback& f : fallbacks) {
-      leave_out(f.loop, "a stride that speeds up or slows down, not needed beside steady cycles");
+      leave_out(f.loop, f.has_contacts ? "a step and its mirror image (the take has no steady "
+                                         "stride), not needed beside steady cycles"
+                                       : "a stride that speeds up or slows down, not needed "
+                                         "beside steady cycles");
     }
   }
   if (lib.clips.empty()) {

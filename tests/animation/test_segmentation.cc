@@ -15,6 +15,7 @@
 
 #include "animation/analysis.h"
 #include "animation/clip_library.h"
+#include "animation/mirror.h"
 #include "animation/pose_jobs.h"
 #include "animation/segmentation.h"
 #include "tests/test_data.h"
@@ -39,6 +40,14 @@ Take load_take(const std::string& rel) {
   t.analysis = analyze_clip(t.clip(), *t.set.skeleton);
   t.seg = segment_take(t.clip(), *t.set.skeleton, t.analysis);
   return t;
+}
+
+std::vector<glm::vec3> joint_positions(const Clip& c, const Skeleton& sk, int f) {
+  std::vector<glm::mat4> model(sk.num_joints());
+  clip_frame_model(c, sk, f, model);
+  std::vector<glm::vec3> out;
+  for (const glm::mat4& m : model) out.push_back(translation_of(m));
+  return out;
 }
 
 std::vector<glm::vec3> joint_track(const Clip& c, const Skeleton& sk, int joint) {
@@ -225,6 +234,68 @@ TEST(Segmentation, StopsEndStandingAndTheTurnTurnsLeft) {
   const TakeSegment* turn = first_of(t.seg, SegmentKind::kTurn);
   ASSERT_NE(turn, nullptr);
   EXPECT_GT(turn->turn_rad * kDeg, 45.0f);
+}
+
+// The stop takes have no steady stride (each slows down by a third or more), but a step that walks:
+// that step and its mirror image make the cycle. The loop is two of its steps long, its feet
+// alternate (each foot down as long as the other, landing half a loop after it) and it travels
+// at the step's speed; turned round in the world first, the take makes the same loop.
+TEST(Segmentation, AStopTakeLoopsItsSteadiestStepAndItsMirrorImage) {
+  for (const char* file : {"clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh",
+                           "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh"}) {
+    REQUIRE_TAKE(file);
+    const Take t = load_take(file);
+    const Skeleton& sk = *t.set.skeleton;
+    ASSERT_TRUE(t.seg.fallback_cycle) << file;
+    ASSERT_GE(t.seg.mirror_step, 0) << file;
+    const Stride& step = t.seg.steps[t.seg.mirror_step];
+    const float fps = t.clip().fps;
+    const int step_frames = static_cast<int>(std::lround((step.span.end_s - step.span.start_s) * fps));
+    const std::vector<int16_t> map = mirror_joint_map(sk);
+    const MirroredCycle mc = extract_mirrored_cycle(t.clip(), sk, t.analysis, step, map);
+    EXPECT_TRUE(mc.loop.loops) << file;
+    EXPECT_EQ(mc.loop.num_frames, 2 * step_frames) << file;
+    const float duration = mc.loop.duration_s();
+    ASSERT_EQ(mc.contacts[0].size(), 1u) << file;
+    ASSERT_EQ(mc.contacts[1].size(), 1u) << file;
+    const TimeInterval l = mc.contacts[0][0], r = mc.contacts[1][0];
+    EXPECT_NEAR(l.end_s - l.start_s, r.end_s - r.start_s, 1.01f / fps) << file;
+    float apart = std::abs(l.start_s - r.start_s);
+    EXPECT_NEAR(apart, 0.5f * duration, 1.01f / fps) << file;
+    const ClipAnalysis la = analyze_clip(mc.loop, sk);
+    EXPECT_NEAR(la.native_speed_m_s, step.speed_m_s, 0.1f * step.speed_m_s) << file;
+
+    // The same take turned 70 degrees about the vertical and moved: the same loop.
+    Clip turned = t.clip();
+    const glm::quat yaw = glm::angleAxis(glm::radians(70.0f), glm::vec3(0, 1, 0));
+    for (int f = 0; f < turned.num_frames; ++f) {
+      for (int j = 0; j < turned.num_joints; ++j) {
+        if (sk.parents[j] >= 0) continue;
+        const size_t i = static_cast<size_t>(f) * turned.num_joints + j;
+        turned.rotations[i] = glm::normalize(yaw * turned.rotations[i]);
+        turned.translations[i] = yaw * turned.translations[i] + glm::vec3(3.0f, 0.0f, -2.0f);
+      }
+    }
+    const ClipAnalysis ta = analyze_clip(turned, sk);
+    const TakeSegmentation ts = segment_take(turned, sk, ta);
+    ASSERT_GE(ts.mirror_step, 0) << file;
+    const MirroredCycle tc = extract_mirrored_cycle(turned, sk, ta, ts.steps[ts.mirror_step], map);
+    EXPECT_EQ(tc.loop.num_frames, mc.loop.num_frames) << file;
+    EXPECT_NEAR(analyze_clip(tc.loop, sk).native_speed_m_s, la.native_speed_m_s,
+                0.02f * la.native_speed_m_s)
+        << file;
+    // Frame by frame, the turned take's loop is the loop turned and moved: the feet keep their
+    // distance from the hips (and each other) to the millimetre.
+    for (int f = 0; f < mc.loop.num_frames; ++f) {
+      const std::vector<glm::vec3> a = joint_positions(mc.loop, sk, f);
+      const std::vector<glm::vec3> b = joint_positions(tc.loop, sk, f);
+      const int hips = sk.role(JointRole::kHips);
+      for (int j = 0; j < sk.num_joints(); ++j) {
+        EXPECT_NEAR(glm::length(a[j] - a[hips]), glm::length(b[j] - b[hips]), 2e-3f)
+            << file << " frame " << f << " " << sk.names[j];
+      }
+    }
+  }
 }
 
 // Contacts against hand labels (tests/data/contact_labels: touchdown and lift-off frames judged

@@ -125,8 +125,12 @@ TEST(DoubtfulClips, SteadyCyclesOfTheSharedDataAreSound) {
     std::vector<ClipSet> sets{std::move(*set)};
     auto lib = build_locomotion_library(sets);
     if (!lib.ok()) continue;  // an idle or a crouch alone: no library, said so by the error
-    bool fallback = false;  // a take without a steady stride: its least unsteady one is cut
-    for (const TakeReport& t : lib->takes) fallback = fallback || t.segmentation.fallback_cycle;
+    // A take without a steady stride: its steadiest step and that step's mirror image make the
+    // cycle (the subject-16 stop takes), or, without a step that walks, its least unsteady stride.
+    bool fallback = false;
+    for (const TakeReport& t : lib->takes) {
+      fallback = fallback || (t.segmentation.fallback_cycle && t.segmentation.mirror_step < 0);
+    }
     if (fallback) {
       // The subject-16 stop takes: no stride is steady, and in the one cut (it slows by half)
       // a foot's contact breaks in two or is a third of the other's: said, and not trusted.

@@ -151,6 +151,28 @@ TEST(Quality, CorridorWithTheSubject16Clips) {
   EXPECT_LE(apm.feet.gmd_skate_ratio, apm.feet_floor.gmd_skate_ratio + 0.002);
 }
 
+// A library of one stop take alone (CMU 16_33: slow walk, stop): it has no steady stride, so its
+// cycle is its steadiest step and that step's mirror image, trusted with foot locks (not played as
+// naive plays it). A plaza crowd at walking speed then keeps its support feet planted. Not yet
+// within the bounds: limb pops (the take's slow walk is played faster than captured, and its
+// reference accelerations are a slow walk's; bench/quality.md has the figures).
+TEST(Quality, PlazaWithOneStopTakeAlone) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = test::load_data_library({"clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  ASSERT_FALSE(gait_analysis_doubtful(*lib));
+  auto a = scenario_crowd("plaza");
+  auto b = scenario_crowd("plaza");
+  const MetricsReport apm = run_source(*a, *lib, MediatorMode::kApm);
+  const MetricsReport naive = run_source(*b, *lib, MediatorMode::kNaive);
+  expect_body_bounds(apm, false, "plaza 16_33");
+  expect_feet_never_below_the_floor(apm, naive, "plaza 16_33");
+  EXPECT_LE(apm.feet.support_slide_cm_s, 2.0);
+  EXPECT_LE(apm.feet.support_skate_ratio, 0.005);
+  EXPECT_LE(apm.feet.float_ratio, 0.01);
+  EXPECT_LE(apm.feet.gmd_skate_ratio, apm.feet_floor.gmd_skate_ratio + 0.002);
+}
+
 TEST(Quality, ReplayedPedestriansWithTheMannequinClips) {
   GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
   GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
