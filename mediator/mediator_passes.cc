@@ -425,24 +425,46 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       // Slowing down: a stop when the speed, falling as it does, reaches rest within the stop
       // clip's own stopping time (with some slack), from a speed the clip walks at.
       // It is entered where the clip has slowed to the agent's speed (a slow agent plays only
-      // the stop's last steps).
-      const int k = nearest_transition(lib, TransitionKind::kStop, v);
-      if (k >= 0) {
-        const Transition& tr = lib.transitions[k];
+      // the stop's last steps). The stop nearest in speed, or its mirror image (the same stop
+      // ending on the other foot): of the two, the one that fits whose first step comes sooner
+      // in the gait, so the agent waits at most about a step for it.
+      const int nearest = nearest_transition(lib, TransitionKind::kStop, v);
+      const float near_v = nearest >= 0 ? lib.transitions[nearest].moving_speed_m_s : 0.0f;
+      const float to_rest = v / -accel;
+      int k = -1;
+      float k_entry = 0.0f, k_wait = 0.0f;
+      for (size_t i = 0; i < lib.transitions.size() && nearest >= 0; ++i) {
+        const Transition& tr = lib.transitions[i];
+        if (tr.kind != TransitionKind::kStop ||
+            std::abs(tr.moving_speed_m_s - near_v) > 0.01f * near_v) {
+          continue;
+        }
         float entry = tr.moving_from_s;
         while (entry < tr.moving_to_s && tr.speed_at(entry) > v) entry += 1.0f / tr.fps;
-        const float to_rest = v / -accel;
-        if (to_rest <= 1.25f * (tr.moving_to_s - entry) + 0.2f &&
-            v <= 1.3f * tr.moving_speed_m_s && entry < tr.moving_to_s) {
-          index = static_cast<int16_t>(k);
-          stage = TransitionStage::kWaiting;
-          st.waited_s[slot] = 0.0f;
-          // A walker who has chosen to stop keeps the cadence to the step the stop begins on
-          // (the slowing shortens the steps, as the stop clip then does): the weights hold it.
-          st.min_cadence[slot] = playback_rate[slot];
-          t = entry;
-          w = 0.0f;
+        if (!(to_rest <= 1.25f * (tr.moving_to_s - entry) + 0.2f &&
+              v <= 1.3f * tr.moving_speed_m_s && entry < tr.moving_to_s)) {
+          continue;
         }
+        const LocomotionClip& cyc = lib.clips[tr.cycle_clip];
+        float entry_phase = tr.cycle_phase + (entry - tr.moving_from_s) / cyc.cycle_s;
+        entry_phase -= std::floor(entry_phase);
+        float wait = entry_phase - phase[slot];
+        wait -= std::floor(wait);
+        if (k < 0 || wait < k_wait) {
+          k = static_cast<int>(i);
+          k_wait = wait;
+          k_entry = entry;
+        }
+      }
+      if (k >= 0) {
+        index = static_cast<int16_t>(k);
+        stage = TransitionStage::kWaiting;
+        st.waited_s[slot] = 0.0f;
+        // A walker who has chosen to stop keeps the cadence to the step the stop begins on
+        // (the slowing shortens the steps, as the stop clip then does): the weights hold it.
+        st.min_cadence[slot] = playback_rate[slot];
+        t = k_entry;
+        w = 0.0f;
       }
     }
     if (stage == TransitionStage::kNone) {
@@ -541,13 +563,17 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     lw[k_min] = 0.0f;
     float rest = 0.0f;
     for (int l = 0; l < kMaxBlendLayers; ++l) rest += lw[l];
+    // The fade eases in and out: a weight that changes at a constant rate starts and stops its
+    // change at once, and every joint's velocity jumps by the two poses' difference over the fade
+    // time (a limb snaps as a stop the agent walks out of fades away).
+    const float wl = smoothstep01(w);
     float gait = 0.0f;
     for (int l = 0; l < kMaxBlendLayers; ++l) {
-      lw[l] = rest > 0.0f ? lw[l] * (1.0f - w) / rest : 0.0f;
+      lw[l] = rest > 0.0f ? lw[l] * (1.0f - wl) / rest : 0.0f;
       if (l != k_min && lib.clips[lc[l]].gait) gait += lw[l];
     }
     lc[k_min] = static_cast<int16_t>(tr.clip);
-    lw[k_min] = rest > 0.0f ? w : 1.0f;
+    lw[k_min] = rest > 0.0f ? wl : 1.0f;
     gait_weight[slot] = gait;
   });
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -112,6 +113,52 @@ TEST(Transitions, TheSubject16TakesGiveAStartAndAStop) {
   }
   EXPECT_GE(starts, 1);
   EXPECT_GE(stops, 1);
+}
+
+// Each stop comes with its mirror image: the same stop ending on the other foot, so its first
+// landing is half a cycle of the gait away from the stop's own.
+TEST(Transitions, EveryStopHasAMirrorImageEndingOnTheOtherFoot) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  std::vector<const Transition*> stops;
+  for (const Transition& t : lib->transitions) {
+    if (t.kind == TransitionKind::kStop) stops.push_back(&t);
+  }
+  ASSERT_EQ(stops.size(), 2u);
+  const Transition& a = *stops[0];
+  const Transition& b = *stops[1];
+  EXPECT_NEAR(a.moving_speed_m_s, b.moving_speed_m_s, 0.01f * a.moving_speed_m_s);
+  EXPECT_NEAR(a.duration_s, b.duration_s, 1e-4f);
+  EXPECT_EQ(a.lead_foot, 1 - b.lead_foot);
+  EXPECT_EQ(a.cycle_clip, b.cycle_clip);
+  float apart = std::abs(a.cycle_phase - b.cycle_phase);
+  apart = std::min(apart, 1.0f - apart);
+  EXPECT_NEAR(apart, 0.5f, 0.1f);
+}
+
+// Whatever foot an agent happens to be on when it starts slowing down (its start phase comes from
+// the seed), it comes to rest in a stop clip: one of the two begins within about a step.
+TEST(Transitions, AnAgentComesToRestInAStopOnEitherFoot) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  int played = 0;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    MediatorParams params;
+    params.seed = seed;
+    test::ScriptedCrowd crowd({{glm::vec2(0.0f), stopping, nullptr}});
+    CrowdPipeline pipeline(*lib, params, test::test_pipeline_options(1, kDt));
+    for (int f = 0; f < 300; ++f) ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+    const auto counts = pipeline.mediator().transition_counts();
+    EXPECT_EQ(counts[kStopsSeen], 1u) << "seed " << seed;
+    EXPECT_EQ(counts[kStopsPlayed], 1u) << "seed " << seed;
+    played += static_cast<int>(counts[kStopsPlayed]);
+    const MetricsReport r = pipeline.metrics()->finish();
+    EXPECT_LE(r.feet.support_slide_cm_s, 2.0) << "seed " << seed;
+    EXPECT_LE(r.root_error_cm.mean, 3.0) << "seed " << seed;
+  }
+  EXPECT_EQ(played, 8);
 }
 
 TEST(Transitions, TheBuiltinLibraryHasNone) {
