@@ -115,10 +115,18 @@ void draw_clip(Canvas& cv, int top, const ClipPlotInput& in) {
       const int sx = static_cast<int>(xt(s.span.start_s)) + 4;
       if (xt(s.span.end_s) - sx > label_width(name, 2) + 8) cv.text(sx, band + 3, name, {20, 20, 20});
     }
-    for (int ci : in.segmentation->cycles) {
-      const Stride& st = in.segmentation->strides[ci];
+    const TakeSegmentation& seg = *in.segmentation;
+    if (seg.fallback_cycle && seg.mirror_step >= 0) {
+      // The step that, with its mirror image, makes the loop: marked in yellow.
+      const Stride& st = seg.steps[seg.mirror_step];
       cv.rect(static_cast<int>(xt(st.span.start_s)), band + kBandH - 4,
-              static_cast<int>(xt(st.span.end_s)), band + kBandH, {255, 255, 255});
+              static_cast<int>(xt(st.span.end_s)), band + kBandH, {255, 220, 60});
+    } else {
+      for (int ci : seg.cycles) {
+        const Stride& st = seg.strides[ci];
+        cv.rect(static_cast<int>(xt(st.span.start_s)), band + kBandH - 4,
+                static_cast<int>(xt(st.span.end_s)), band + kBandH, {255, 255, 255});
+      }
     }
   }
   cv.text(6, band + 3, "PARTS", {200, 200, 200});

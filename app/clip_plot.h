@@ -1,8 +1,9 @@
 #pragma once
 // `analyze-clip --plot FILE.png`: each foot's toe height and speed over the take, with the
 // contacts clip analysis found shaded under the curves and the take's segments (idle, start,
-// steady, turn, stop) as a coloured band with the cut-out loops marked, so a user sees at a
-// glance whether the analysis is right.
+// steady, turn, stop) as a coloured band with the cut-out loops marked (white; yellow: the step
+// whose mirror image completes a take's loop), so a user sees at a glance whether the analysis is
+// right.
 
 #include <string>
 #include <vector>
