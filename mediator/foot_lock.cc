@@ -20,37 +20,77 @@ constexpr float kMaxCoordinate = 1e6f;
 bool usable(float x) { return std::isfinite(x) && std::abs(x) <= kMaxCoordinate; }
 bool usable(const glm::vec3& v) { return usable(v.x) && usable(v.y) && usable(v.z); }
 
+// True when step_foot_lock has some input value to replace (sanitise).
+bool needs_sanitising(const FootLockInput& in) {
+  return !usable(in.anim_toe_prev) || !usable(in.drawn_toe_prev) || !usable(in.floor_toe_m) ||
+         !std::isfinite(in.swing_progress) || !std::isfinite(in.still_speed_m_s);
+}
+
 // The input with unusable values replaced as step_foot_lock documents (anim_toe is usable).
-FootLockInput sanitised(const FootLockInput& in) {
-  FootLockInput out = in;
+void sanitise(FootLockInput& out) {
   if (!usable(out.anim_toe_prev)) out.anim_toe_prev = out.anim_toe;
   if (!usable(out.drawn_toe_prev)) out.drawn_toe_prev = out.anim_toe;
   if (!usable(out.floor_toe_m)) out.floor_toe_m = std::numeric_limits<float>::lowest();
   if (!std::isfinite(out.swing_progress)) out.swing_progress = 0.0f;
   if (!std::isfinite(out.still_speed_m_s)) out.still_speed_m_s = 0.0f;
-  return out;
 }
+
+// The transitions and the per-state steps below change one FootLock in place: the state is some
+// 150 bytes, and a copy per function (each written field by field, then read back whole) cost
+// more than the arithmetic. The public functions at the end keep their value form.
 
 // A pinned toe follows the clip's toe down onto the floor as the foot rolls from the heel onto
 // the ball, and never up again while the ball bears weight (the heel rises about it).
-FootLock lower_pin(const FootLock& s, const FootLockInput& in) {
-  FootLock out = s;
-  out.target.y = std::min(out.target.y, std::max(in.floor_toe_m, in.anim_toe.y));
-  return out;
+void lower_pin(FootLock& s, const FootLockInput& in) {
+  s.target.y = std::min(s.target.y, std::max(in.floor_toe_m, in.anim_toe.y));
 }
 
 // The offset of a foot that is not being released decays toward zero (Holden's decay spring:
 // exact for any dt).
-FootLock decay_offset(const FootLock& s, const FootLockParams& p, float dt) {
-  FootLock out = s;
-  critical_spring(out.offset, out.offset_vel, glm::vec3(0.0f), p.release_halflife_s, dt);
-  return out;
+void decay_offset(FootLock& s, const FootLockParams& p, float dt) {
+  critical_spring(s.offset, s.offset_vel, glm::vec3(0.0f), p.release_halflife_s, dt);
+}
+
+void plant(FootLock& s, const FootLockInput& in) {
+  // Pinned no higher than it is drawn (a pinned toe never rises) nor than the clip has it, and
+  // never below the floor; a foot drawn above that settles down onto it.
+  const glm::vec3 at = in.fresh ? in.anim_toe : in.drawn_toe_prev;
+  const float drawn_y = at.y;
+  const float y = std::max(in.floor_toe_m, std::min(drawn_y, in.anim_toe.y));
+  s.state = FootLockState::kLocked;
+  s.target = glm::vec3(at.x, y, at.z);
+  s.offset = glm::vec3(0.0f, std::max(0.0f, drawn_y - y), 0.0f);
+  s.offset_vel = glm::vec3(0.0f);
+}
+
+// The vectors by value: callers pass fields of s itself.
+void start_step(FootLock& s, glm::vec3 from) {
+  s.state = FootLockState::kStepping;
+  s.from = usable(from) ? from : s.last_goal;
+  s.timer_s = 0.0f;
+  s.offset = s.offset_vel = glm::vec3(0.0f);
+}
+
+void release(FootLock& s, glm::vec3 drawn_toe, glm::vec3 drawn_vel, glm::vec3 anim_toe,
+             glm::vec3 anim_vel) {
+  const glm::vec3 drawn = usable(drawn_toe) ? drawn_toe : s.last_goal;
+  const glm::vec3 anim = usable(anim_toe) ? anim_toe : drawn;
+  const glm::vec3 dv = usable(drawn_vel) ? drawn_vel : glm::vec3(0.0f);
+  const glm::vec3 av = usable(anim_vel) ? anim_vel : glm::vec3(0.0f);
+  s.state = FootLockState::kReleasing;
+  s.from = drawn;
+  s.offset = drawn - anim;
+  s.offset_vel = dv - av;
+  s.carry = glm::vec3(0.0f);
+  s.carry_vel = glm::vec3(s.offset_vel.x, 0.0f, s.offset_vel.z);
+  s.shed = s.shed_from = s.shed_goal = s.released_s = s.release_time_s = 0.0f;
+  s.swing_from = -1.0f;  // taken from the first frame's progress
 }
 
 // This frame's transition from the state the foot was in. speed and last_speed are the clip's toe
 // speed over the ground this frame and last (< 0: none).
-FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockParams& p,
-                    const glm::vec3& anim_vel, float speed, float last_speed) {
+void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
+                const glm::vec3& anim_vel, float speed, float last_speed) {
   switch (s.state) {
     case FootLockState::kFree:
     case FootLockState::kReleasing: {
@@ -62,129 +102,125 @@ FootLock transition(const FootLock& s, const FootLockInput& in, const FootLockPa
       const bool at_rest =
           in.fresh || speed <= in.still_speed_m_s || (last_speed >= 0.0f && speed >= last_speed);
       const bool carries_weight = !in.other_locked;
-      return in.plant && (at_rest || carries_weight) ? plant_foot(s, in) : s;
+      if (in.plant && (at_rest || carries_weight)) plant(s, in);
+      return;
     }
     case FootLockState::kLocked: {
-      const FootLock pinned = lower_pin(s, in);
       if (!in.hold && !in.other_landing) {
         // Released from rest: the offset is taken against where the clip's toe was last frame,
         // and the foot's rest against the clip's speed is carried on and shed (inertialization),
         // so the drawn foot sets off from rest: taking the clip's lift-off speed at once, the
         // knee of a leg stretched to its pin would snap.
-        return release_foot_lock(pinned, pinned.target + pinned.offset, glm::vec3(0.0f),
-                                 in.anim_toe_prev, anim_vel);
+        lower_pin(s, in);
+        release(s, s.target + s.offset, glm::vec3(0.0f), in.anim_toe_prev, anim_vel);
+        return;
       }
       // A foot left behind by a turn or a drift while the clips stand re-plants with a short step,
       // one foot at a time (walking, its own swing comes and takes the offset).
-      const float drift = std::hypot(s.target.x - in.anim_toe.x, s.target.z - in.anim_toe.z);
+      const float drift = ground_length(s.target.x - in.anim_toe.x, s.target.z - in.anim_toe.z);
       if (drift > p.step_distance_m && in.other_locked && !in.walking) {
-        return start_foot_step(pinned, pinned.target + pinned.offset);
+        lower_pin(s, in);
+        start_step(s, s.target + s.offset);
       }
-      return s;
+      // Otherwise the pin is kept as it is (pinned_foot lowers it below).
+      return;
     }
     case FootLockState::kStepping: {
       // The clips lift the foot before the step is done: it joins their swing from where it is,
       // at the speed it has.
-      if (in.hold) return s;
+      if (in.hold) return;
       // The offset is taken against where the clip's toe was when the step was last drawn: this
       // frame the drawn foot then moves on with the step's own velocity (carried on), not
       // with that less the clip's (a jolt of a frame, as the clip's foot is lifting fast).
-      return release_foot_lock(s, s.last_goal, s.goal_vel, in.anim_toe_prev, anim_vel);
+      release(s, s.last_goal, s.goal_vel, in.anim_toe_prev, anim_vel);
+      return;
     }
   }
-  return s;
 }
 
 // A free foot is drawn at the clip's toe plus what is left of a landing offset.
-FootLockStep free_foot(const FootLock& s, const FootLockInput& in) {
-  return {s, in.anim_toe + s.offset};
-}
+glm::vec3 free_foot(const FootLock& s, const FootLockInput& in) { return in.anim_toe + s.offset; }
 
 // A pinned foot is drawn at its pin (lowered onto the clip's toe) plus the settling offset.
-FootLockStep pinned_foot(const FootLock& s, const FootLockInput& in) {
-  const FootLock out = lower_pin(s, in);
-  return {out, out.target + out.offset};
+glm::vec3 pinned_foot(FootLock& s, const FootLockInput& in) {
+  lower_pin(s, in);
+  return s.target + s.offset;
 }
 
 // A released foot sheds its offset in the swing's progress from where the release began, and
 // never in less than twice the halflife; done, it is free.
-FootLockStep releasing_foot(const FootLock& s, const FootLockInput& in, const FootLockParams& p,
-                            float dt) {
-  FootLock out = s;
-  if (out.swing_from < 0.0f) {
+glm::vec3 releasing_foot(FootLock& s, const FootLockInput& in, const FootLockParams& p, float dt) {
+  if (s.swing_from < 0.0f) {
     // The release's shortest time: twice the halflife, and long enough that the foot is never
     // carried faster than the clips' own swing (smoothstep's speed peaks at 1.5 times its mean).
-    const float across = std::hypot(out.offset.x, out.offset.z);
-    out.release_time_s = 2.0f * p.release_halflife_s;
+    const float across = ground_length(s.offset.x, s.offset.z);
+    s.release_time_s = 2.0f * p.release_halflife_s;
     if (p.swing_speed_m_s > 0.0f) {
-      out.release_time_s = std::max(out.release_time_s, 1.5f * across / p.swing_speed_m_s);
+      s.release_time_s = std::max(s.release_time_s, 1.5f * across / p.swing_speed_m_s);
     }
   }
   // A progress that went back, as when the blend changes clips, restarts the count from there:
   // never a jump.
-  if (out.swing_from < 0.0f || in.swing_progress + 0.05f < out.swing_from) {
-    out.swing_from = std::min(in.swing_progress, 0.9f);
-    out.shed_from = out.shed_goal;
+  if (s.swing_from < 0.0f || in.swing_progress + 0.05f < s.swing_from) {
+    s.swing_from = std::min(in.swing_progress, 0.9f);
+    s.shed_from = s.shed_goal;
   }
-  const float u = (in.swing_progress - out.swing_from) / (1.0f - out.swing_from);
-  out.shed_goal = std::max(out.shed_goal, out.shed_from + (1.0f - out.shed_from) * smoothstep01(u));
+  const float u = (in.swing_progress - s.swing_from) / (1.0f - s.swing_from);
+  s.shed_goal = std::max(s.shed_goal, s.shed_from + (1.0f - s.shed_from) * smoothstep01(u));
   // A release late in the swing still takes its time (twice the halflife at least), not a frame
   // or two; it may then land before the offset is gone, and is pinned where it is.
-  out.released_s += dt;
-  const float by_time = smoothstep01(out.released_s / out.release_time_s);
-  out.shed = std::max(out.shed, std::min(out.shed_goal, by_time));
+  s.released_s += dt;
+  const float by_time = smoothstep01(s.released_s / s.release_time_s);
+  s.shed = std::max(s.shed, std::min(s.shed_goal, by_time));
   // Upward the foot follows the clip's lift at once (a spring, so the knee does not snap);
   // sideways it is corrected over the swing. A foot released above the clip's (a re-planting
   // step the clips lift) comes down to it over the swing as well: pulled down at once, the knee
   // would snap straight.
-  const bool above = out.offset.y > 0.0f;
+  const bool above = s.offset.y > 0.0f;
   if (!above) {
-    float y = out.offset.y, vy = out.offset_vel.y;
+    float y = s.offset.y, vy = s.offset_vel.y;
     critical_spring(y, vy, 0.0f, 0.5f * p.release_halflife_s, dt);
-    out.offset.y = y;
-    out.offset_vel.y = vy;
+    s.offset.y = y;
+    s.offset_vel.y = vy;
   }
-  critical_spring(out.carry, out.carry_vel, glm::vec3(0.0f), p.carry_halflife_s, dt);
-  glm::vec3 goal = in.anim_toe + out.offset * (1.0f - out.shed) + out.carry;
-  goal.y = in.anim_toe.y + (above ? out.offset.y * (1.0f - out.shed) : out.offset.y);
-  if (out.shed >= 1.0f) {
+  critical_spring(s.carry, s.carry_vel, glm::vec3(0.0f), p.carry_halflife_s, dt);
+  glm::vec3 goal = in.anim_toe + s.offset * (1.0f - s.shed) + s.carry;
+  goal.y = in.anim_toe.y + (above ? s.offset.y * (1.0f - s.shed) : s.offset.y);
+  if (s.shed >= 1.0f) {
     // Free; what is left of a carried velocity goes on decaying as the free foot's offset, so the
     // foot joins the clip's without a jump.
-    out.state = FootLockState::kFree;
-    out.offset = out.carry;
-    out.offset_vel = out.carry_vel;
-    out.carry = out.carry_vel = glm::vec3(0.0f);
+    s.state = FootLockState::kFree;
+    s.offset = s.carry;
+    s.offset_vel = s.carry_vel;
+    s.carry = s.carry_vel = glm::vec3(0.0f);
   }
-  return {out, goal};
+  return goal;
 }
 
 // A re-planting step: lifted, carried and set down where the clip has the foot, as high as the
 // clips' own swing: the foot rises before it moves and stops moving before it lands (zero speed at
 // both ends, so nothing snaps). Landed, it is pinned there.
-FootLockStep stepping_foot(const FootLock& s, const FootLockInput& in, const FootLockParams& p,
-                           float dt) {
-  FootLock out = s;
-  out.timer_s += dt;
-  const float u = std::min(1.0f, out.timer_s / p.step_time_s);
+glm::vec3 stepping_foot(FootLock& s, const FootLockInput& in, const FootLockParams& p, float dt) {
+  s.timer_s += dt;
+  const float u = std::min(1.0f, s.timer_s / p.step_time_s);
   const float sn = std::sin(std::numbers::pi_v<float> * u);
   glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
   // Where it lands is chosen before it comes down: it follows the clip's foot while it is
   // carried, and is set down on the spot it was carried to (a body turning on the spot would
   // otherwise drag the landing foot along the ground).
   if (u < 1.0f - kStepLift) {
-    out.step_to = to;
+    s.step_to = to;
   } else {
-    to.x = out.step_to.x;
-    to.z = out.step_to.z;
+    to.x = s.step_to.x;
+    to.z = s.step_to.z;
   }
-  glm::vec3 goal =
-      glm::mix(out.from, to, smoothstep01((u - kStepLift) / (1.0f - 2.0f * kStepLift)));
-  goal.y = glm::mix(out.from.y, to.y, smoothstep01(u)) + p.step_height_m * sn * sn;
+  glm::vec3 goal = glm::mix(s.from, to, smoothstep01((u - kStepLift) / (1.0f - 2.0f * kStepLift)));
+  goal.y = glm::mix(s.from.y, to.y, smoothstep01(u)) + p.step_height_m * sn * sn;
   if (u >= 1.0f) {
-    out.state = FootLockState::kLocked;
-    out.target = to;
+    s.state = FootLockState::kLocked;
+    s.target = to;
   }
-  return {out, goal};
+  return goal;
 }
 
 }  // namespace
@@ -196,81 +232,74 @@ FootLock fresh_foot_lock(const glm::vec3& anim_toe) {
 }
 
 FootLock plant_foot(const FootLock& s, const FootLockInput& in) {
-  // Pinned no higher than it is drawn (a pinned toe never rises) nor than the clip has it, and
-  // never below the floor; a foot drawn above that settles down onto it.
-  const glm::vec3 at = in.fresh ? in.anim_toe : in.drawn_toe_prev;
-  const float drawn_y = at.y;
-  const float y = std::max(in.floor_toe_m, std::min(drawn_y, in.anim_toe.y));
   FootLock out = s;
-  out.state = FootLockState::kLocked;
-  out.target = glm::vec3(at.x, y, at.z);
-  out.offset = glm::vec3(0.0f, std::max(0.0f, drawn_y - y), 0.0f);
-  out.offset_vel = glm::vec3(0.0f);
+  plant(out, in);
   return out;
 }
 
 FootLock start_foot_step(const FootLock& s, const glm::vec3& from) {
   FootLock out = s;
-  out.state = FootLockState::kStepping;
-  out.from = usable(from) ? from : s.last_goal;
-  out.timer_s = 0.0f;
-  out.offset = out.offset_vel = glm::vec3(0.0f);
+  start_step(out, from);
   return out;
 }
 
 FootLock release_foot_lock(const FootLock& s, const glm::vec3& drawn_toe,
                            const glm::vec3& drawn_vel, const glm::vec3& anim_toe,
                            const glm::vec3& anim_vel) {
-  const glm::vec3 drawn = usable(drawn_toe) ? drawn_toe : s.last_goal;
-  const glm::vec3 anim = usable(anim_toe) ? anim_toe : drawn;
-  const glm::vec3 dv = usable(drawn_vel) ? drawn_vel : glm::vec3(0.0f);
-  const glm::vec3 av = usable(anim_vel) ? anim_vel : glm::vec3(0.0f);
   FootLock out = s;
-  out.state = FootLockState::kReleasing;
-  out.from = drawn;
-  out.offset = drawn - anim;
-  out.offset_vel = dv - av;
-  out.carry = glm::vec3(0.0f);
-  out.carry_vel = glm::vec3(out.offset_vel.x, 0.0f, out.offset_vel.z);
-  out.shed = out.shed_from = out.shed_goal = out.released_s = out.release_time_s = 0.0f;
-  out.swing_from = -1.0f;  // taken from the first frame's progress
+  release(out, drawn_toe, drawn_vel, anim_toe, anim_vel);
   return out;
 }
 
-FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& raw,
-                            const FootLockParams& p, float dt) {
+glm::vec3 advance_foot_lock(FootLock& s, const FootLockInput& raw, const FootLockParams& p,
+                            float dt) {
   // Nothing to follow or no time step: the foot stays as it is (a fresh one at the origin).
   if (!usable(raw.anim_toe) || !(dt > 0.0f) || !std::isfinite(dt)) {
-    const FootLock s = raw.fresh ? FootLock() : state;
-    return {s, s.last_goal};
+    if (raw.fresh) s = FootLock();
+    return s.last_goal;
   }
-  const FootLockInput in = sanitised(raw);
-  FootLock s = in.fresh ? fresh_foot_lock(in.anim_toe) : state;
+  // Almost every input is usable as it is: it is read in place, not copied.
+  FootLockInput fixed;
+  const FootLockInput* use = &raw;
+  if (needs_sanitising(raw)) {
+    fixed = raw;
+    sanitise(fixed);
+    use = &fixed;
+  }
+  const FootLockInput& in = *use;
+  if (in.fresh) s = fresh_foot_lock(in.anim_toe);
   const glm::vec3 anim_vel = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
   // The clip's toe speed over the ground, this frame and last (< 0: none yet).
-  const float speed = std::hypot(anim_vel.x, anim_vel.z);
+  const float speed = ground_length(anim_vel.x, anim_vel.z);
   const float last_speed = s.anim_speed;
   s.anim_speed = in.fresh ? -1.0f : speed;
 
-  s = transition(s, in, p, anim_vel, speed, last_speed);
-  if (s.state != FootLockState::kReleasing) s = decay_offset(s, p, dt);
-  FootLockStep next{s, in.anim_toe};
+  transition(s, in, p, anim_vel, speed, last_speed);
+  if (s.state != FootLockState::kReleasing) decay_offset(s, p, dt);
+  glm::vec3 goal = in.anim_toe;
   switch (s.state) {
     case FootLockState::kFree:
-      next = free_foot(s, in);
+      goal = free_foot(s, in);
       break;
     case FootLockState::kLocked:
-      next = pinned_foot(s, in);
+      goal = pinned_foot(s, in);
       break;
     case FootLockState::kReleasing:
-      next = releasing_foot(s, in, p, dt);
+      goal = releasing_foot(s, in, p, dt);
       break;
     case FootLockState::kStepping:
-      next = stepping_foot(s, in, p, dt);
+      goal = stepping_foot(s, in, p, dt);
       break;
   }
-  next.state.goal_vel = in.fresh ? glm::vec3(0.0f) : (next.goal - next.state.last_goal) / dt;
-  next.state.last_goal = next.goal;
+  s.goal_vel = in.fresh ? glm::vec3(0.0f) : (goal - s.last_goal) / dt;
+  s.last_goal = goal;
+  return goal;
+}
+
+FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& in,
+                            const FootLockParams& p, float dt) {
+  FootLockStep next{state, glm::vec3(0.0f)};
+  next.goal = advance_foot_lock(next.state, in, p, dt);
   return next;
 }
 

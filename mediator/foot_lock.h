@@ -116,6 +116,11 @@ struct FootLockStep {
 FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& in,
                             const FootLockParams& params, float dt_s);
 
+// step_foot_lock with the state advanced where it is stored: the same state and goal, without
+// copying the state in and out (pose synthesis runs it for every foot each frame).
+glm::vec3 advance_foot_lock(FootLock& state, const FootLockInput& in, const FootLockParams& params,
+                            float dt_s);
+
 // A new agent's foot: unlocked, drawn at the clip's toe (no offset, no speed).
 FootLock fresh_foot_lock(const glm::vec3& anim_toe);
 

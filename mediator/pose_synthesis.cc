@@ -618,9 +618,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                         other_coming_down);
     in.floor_toe_m = library_.planted_toe_m[side];
     in.still_speed_m_s = still_speed_m_s(pl.speed_m_s[slot]);
-    const FootLockStep next = step_foot_lock(locks_.lock[k], in, lp, dt);
-    locks_.lock[k] = next.state;
-    goal[side] = next.goal;
+    goal[side] = advance_foot_lock(locks_.lock[k], in, lp, dt);
     anim_vel[side] = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
 
     locks_.anim_toe[k] = anim_toe[side];
@@ -637,7 +635,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                                  translation_of(world_[base + skeleton_.toe(sd)]);
     const glm::vec3 hip_p = translation_of(world_[base + skeleton_.hip(sd)]);
     const float reach = kDropReach * library_.leg_length_m[side];
-    const float dx = std::hypot(ankle_goal.x - hip_p.x, ankle_goal.z - hip_p.z);
+    const float dx = ground_length(ankle_goal.x - hip_p.x, ankle_goal.z - hip_p.z);
     const float dy = hip_p.y - ankle_goal.y;
     if (dx < reach && dy > 0.0f) needed = std::max(needed, dy - std::sqrt(reach * reach - dx * dx));
   }

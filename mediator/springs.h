@@ -30,6 +30,15 @@ inline float smoothstep01(float x) {
   return x * x * (3.0f - 2.0f * x);
 }
 
+// Length of (x, z), as std::hypot(x, z) gives it for finite x and z, without the libm call:
+// glibc's hypotf squares in double (a finite float's square cannot overflow it), takes the root
+// and rounds once, and so does this (the same bits). Only infinities with NaN differ (hypot's
+// infinity, here NaN), and callers compare either against finite limits alike.
+inline float ground_length(float x, float z) {
+  const double dx = x, dz = z;
+  return static_cast<float>(std::sqrt(dx * dx + dz * dz));
+}
+
 inline float wrap_pi(float a) {
   constexpr float kPi = std::numbers::pi_v<float>;
   a += kPi;
