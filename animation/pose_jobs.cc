@@ -472,8 +472,9 @@ void LocalToModelJob::run() const {
     _mm_storeu_ps(m + 12,
                   _mm_add_ps(column(_mm_set1_ps(t.x), _mm_set1_ps(t.y), _mm_set1_ps(t.z)), p3));
   };
-  for (; j + 4 <= end; j += 4) {
-    const Quat4 q = load4(rotations.data() + j);
+  // The rotation matrices of the four joints from q on; the first `count` of them composed.
+  auto group = [&](int first, const glm::quat* q4, int count) __attribute__((always_inline)) {
+    const Quat4 q = load4(q4);
     const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
     const __m128 xx = _mm_mul_ps(q.x, q.x), yy = _mm_mul_ps(q.y, q.y), zz = _mm_mul_ps(q.z, q.z);
     const __m128 xz = _mm_mul_ps(q.x, q.z), xy = _mm_mul_ps(q.x, q.y), yz = _mm_mul_ps(q.y, q.z);
@@ -487,10 +488,20 @@ void LocalToModelJob::run() const {
                          _mm_mul_ps(two, _mm_add_ps(xz, wy)),
                          _mm_mul_ps(two, _mm_sub_ps(yz, wx)),
                          _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)))};
-    compose(j, e, std::integral_constant<int, 0>{});
-    compose(j + 1, e, std::integral_constant<int, 1>{});
-    compose(j + 2, e, std::integral_constant<int, 2>{});
-    compose(j + 3, e, std::integral_constant<int, 3>{});
+    compose(first, e, std::integral_constant<int, 0>{});
+    if (count > 1) compose(first + 1, e, std::integral_constant<int, 1>{});
+    if (count > 2) compose(first + 2, e, std::integral_constant<int, 2>{});
+    if (count > 3) compose(first + 3, e, std::integral_constant<int, 3>{});
+  };
+  for (; j + 4 <= end; j += 4) group(j, rotations.data() + j, 4);
+  if (j < end) {
+    // The last one to three joints (partial updates are mostly such short runs: a leg's hip and
+    // knee, an ankle and its toe) padded to four with identities: a lane computes what the
+    // scalar loop would, in fewer instructions; the padding is not composed.
+    glm::quat tail[4];
+    for (int k = 0; k < 4; ++k) tail[k] = j + k < end ? rotations[j + k] : glm::quat(1, 0, 0, 0);
+    group(j, tail, end - j);
+    j = end;
   }
 #endif
   for (; j < end; ++j) {
