@@ -594,11 +594,17 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // The clip's toe, no lower than the gait clips alone have it (a walk blended with a standing
     // pose swings lower); the more the blend stands, the less of that height is given back, so
     // it fades in and out with the blend.
-    anim_toe[side] = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
-    const float lost = pl.gait_toe_y[side][slot] + root[3].y - anim_toe[side].y;
-    anim_toe[side].y += std::max(0.0f, lost) * smoothstep01(2.0f * pl.gait_weight[slot]);
+    // Made whole in registers and stored once: a vector stored and then changed in memory is
+    // read back (below) from two stores, which the load cannot take from the store buffer, and
+    // it waits for every store before it (a streamed palette's too) to drain.
+    const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+    const float lost = pl.gait_toe_y[side][slot] + root[3].y - drawn.y;
+    const glm::vec3 toe(drawn.x,
+                        drawn.y + std::max(0.0f, lost) * smoothstep01(2.0f * pl.gait_weight[slot]),
+                        drawn.z);
+    anim_toe[side] = toe;
     FootLockInput in;
-    in.anim_toe = anim_toe[side];
+    in.anim_toe = toe;
     in.anim_toe_prev = locks_.anim_toe[k];
     in.drawn_toe_prev = locks_.drawn_toe[k];
     in.fresh = pl.fresh[slot] != 0;
