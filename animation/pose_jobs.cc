@@ -67,6 +67,12 @@ Quat4 weighted_sum4(const Quat4& a, __m128 wa, const Quat4& b, __m128 wb, __m128
   return {lane(a.x, b.x), lane(a.y, b.y), lane(a.z, b.z), lane(a.w, b.w)};
 }
 
+// Lane k of v in all four lanes (the bits moved, not computed).
+template <int k>
+__m128 broadcast_lane(__m128 v) {
+  return _mm_castsi128_ps(_mm_shuffle_epi32(_mm_castps_si128(v), _MM_SHUFFLE(k, k, k, k)));
+}
+
 // glm::normalize: q / |q|, identity where |q| <= 0.
 Quat4 normalize4(const Quat4& q) {
   const __m128 len = _mm_sqrt_ps(dot4(q, q));
@@ -457,7 +463,8 @@ void LocalToModelJob::run() const {
   };
   auto compose = [&](int joint, const __m128* e, auto lane) {
     constexpr int k = decltype(lane)::value;
-    auto at = [&](int i) { return _mm_shuffle_ps(e[i], e[i], _MM_SHUFFLE(k, k, k, k)); };
+    // pshufd broadcasts a lane in one instruction (shufps needs a register copy first).
+    auto at = [&](int i) { return broadcast_lane<k>(e[i]); };
     const glm::mat4& p = parent_of(joint);
     const __m128 p0 = _mm_loadu_ps(&p[0].x), p1 = _mm_loadu_ps(&p[1].x), p2 = _mm_loadu_ps(&p[2].x),
                  p3 = _mm_loadu_ps(&p[3].x);
@@ -638,9 +645,11 @@ void SkinningPaletteJob::run() const {
                    a2 = _mm_loadu_ps(&a[2].x), a3 = _mm_loadu_ps(&a[3].x);
       float* m = &out_palette[j][0].x;
       for (int c = 0; c < 4; ++c) {
-        __m128 col = _mm_add_ps(
-            _mm_add_ps(_mm_mul_ps(a0, _mm_set1_ps(b[c][0])), _mm_mul_ps(a1, _mm_set1_ps(b[c][1]))),
-            _mm_mul_ps(a2, _mm_set1_ps(b[c][2])));
+        // The column loaded once, its entries broadcast from the register.
+        const __m128 bc = _mm_loadu_ps(&b[c].x);
+        __m128 col = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, broadcast_lane<0>(bc)),
+                                           _mm_mul_ps(a1, broadcast_lane<1>(bc))),
+                                _mm_mul_ps(a2, broadcast_lane<2>(bc)));
         if (c == 3) col = _mm_add_ps(col, a3);
         _mm_stream_ps(m + 4 * c, col);
       }
