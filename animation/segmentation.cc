@@ -115,6 +115,31 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
   const TakeTrack tr = track_take(take, sk);
   const std::vector<float> speed = smoothed_speed(tr, fps, 0.25f);
 
+  // A stride or a step from t0 to t1 (side: the foot down at t0) measured: its speed, its two
+  // halves' speeds (v1, v2), its turn and its travel direction; steady when the halves' speeds
+  // differ by less than steady_speed_change, it turns less than max_turn and both halves move.
+  // False when it spans fewer than two frames.
+  auto measure = [&](float t0, float t1, int side, float max_turn, Stride* st, float* v1,
+                     float* v2) {
+    const int f0 = frame_at(t0, fps, n), f1 = frame_at(t1, fps, n);
+    if (f1 - f0 < 2) return false;
+    const int fm = (f0 + f1) / 2;
+    st->span = {t0, t1};
+    st->side = side;
+    const glm::vec2 d = tr.hips[f1] - tr.hips[f0];
+    st->speed_m_s = glm::length(d) * fps / (f1 - f0);
+    *v1 = glm::length(tr.hips[fm] - tr.hips[f0]) * fps / std::max(1, fm - f0);
+    *v2 = glm::length(tr.hips[f1] - tr.hips[fm]) * fps / std::max(1, f1 - fm);
+    st->speed_change = st->speed_m_s > 1e-3f ? (*v2 - *v1) / st->speed_m_s : 0.0f;
+    st->turn_rad = tr.facing[f1] - tr.facing[f0];
+    const float mean_facing = 0.5f * (tr.facing[f0] + tr.facing[f1]);
+    st->direction_rad =
+        st->speed_m_s > 1e-3f ? wrap(std::atan2(d.x, d.y) - mean_facing) : 0.0f;
+    st->steady = std::abs(st->speed_change) < th.steady_speed_change &&
+                 std::abs(st->turn_rad) < max_turn && *v1 > th.idle_speed_m_s &&
+                 *v2 > th.idle_speed_m_s;
+    return true;
+  };
   // Strides: from each contact start of a foot to its next, with exactly one contact start of the
   // other foot between them (the feet alternate).
   for (int s = 0; s < 2; ++s) {
@@ -129,24 +154,8 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
       for (const TimeInterval& o : other) between += o.start_s > t0 && o.start_s < t1;
       if (between != 1) continue;
       Stride st;
-      st.span = {t0, t1};
-      st.side = s;
-      const int f0 = frame_at(t0, fps, n), f1 = frame_at(t1, fps, n);
-      const int fm = (f0 + f1) / 2;
-      if (f1 - f0 < 2) continue;
-      const glm::vec2 d = tr.hips[f1] - tr.hips[f0];
-      st.speed_m_s = glm::length(d) * fps / (f1 - f0);
-      const float v1 = glm::length(tr.hips[fm] - tr.hips[f0]) * fps / std::max(1, fm - f0);
-      const float v2 = glm::length(tr.hips[f1] - tr.hips[fm]) * fps / std::max(1, f1 - fm);
-      st.speed_change = st.speed_m_s > 1e-3f ? (v2 - v1) / st.speed_m_s : 0.0f;
-      st.turn_rad = tr.facing[f1] - tr.facing[f0];
-      const float mean_facing = 0.5f * (tr.facing[f0] + tr.facing[f1]);
-      st.direction_rad =
-          st.speed_m_s > 1e-3f ? wrap(std::atan2(d.x, d.y) - mean_facing) : 0.0f;
-      st.steady = std::abs(st.speed_change) < th.steady_speed_change &&
-                  std::abs(st.turn_rad) < th.steady_turn_rad && v1 > th.idle_speed_m_s &&
-                  v2 > th.idle_speed_m_s;
-      out.strides.push_back(st);
+      float v1 = 0.0f, v2 = 0.0f;
+      if (measure(t0, t1, s, th.steady_turn_rad, &st, &v1, &v2)) out.strides.push_back(st);
     }
   }
   std::sort(out.strides.begin(), out.strides.end(),
@@ -166,25 +175,9 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
       for (const TimeInterval& m : a.contacts[s]) again = again || (m.start_s > t0 && m.start_s < t1);
       const float dur = t1 - t0;
       if (again || dur < 0.5f * th.min_stride_s || dur > 0.5f * th.max_stride_s) continue;
-      const int f0 = frame_at(t0, fps, n), f1 = frame_at(t1, fps, n);
-      if (f1 - f0 < 2) continue;
-      const int fm = (f0 + f1) / 2;
       Stride st;
-      st.span = {t0, t1};
-      st.side = s;
-      const glm::vec2 d = tr.hips[f1] - tr.hips[f0];
-      st.speed_m_s = glm::length(d) * fps / (f1 - f0);
-      const float v1 = glm::length(tr.hips[fm] - tr.hips[f0]) * fps / std::max(1, fm - f0);
-      const float v2 = glm::length(tr.hips[f1] - tr.hips[fm]) * fps / std::max(1, f1 - fm);
-      st.speed_change = st.speed_m_s > 1e-3f ? (v2 - v1) / st.speed_m_s : 0.0f;
-      st.turn_rad = tr.facing[f1] - tr.facing[f0];
-      const float mean_facing = 0.5f * (tr.facing[f0] + tr.facing[f1]);
-      st.direction_rad =
-          st.speed_m_s > 1e-3f ? wrap(std::atan2(d.x, d.y) - mean_facing) : 0.0f;
-      st.steady = std::abs(st.speed_change) < th.steady_speed_change &&
-                  std::abs(st.turn_rad) < 0.5f * th.steady_turn_rad && v1 > th.idle_speed_m_s &&
-                  v2 > th.idle_speed_m_s;
-      out.steps.push_back(st);
+      float v1 = 0.0f, v2 = 0.0f;
+      if (measure(t0, t1, s, 0.5f * th.steady_turn_rad, &st, &v1, &v2)) out.steps.push_back(st);
     }
   }
   std::sort(out.steps.begin(), out.steps.end(),
@@ -307,10 +300,9 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
     // a steady stride's): with its mirror image, a stride of one pace.
     for (size_t i = 0; i < out.steps.size(); ++i) {
       const Stride& st = out.steps[i];
-      const int f0 = frame_at(st.span.start_s, fps, n), f1 = frame_at(st.span.end_s, fps, n);
-      const int fm = (f0 + f1) / 2;
-      const float v1 = glm::length(tr.hips[fm] - tr.hips[f0]) * fps / std::max(1, fm - f0);
-      const float v2 = glm::length(tr.hips[f1] - tr.hips[fm]) * fps / std::max(1, f1 - fm);
+      Stride again;
+      float v1 = 0.0f, v2 = 0.0f;
+      measure(st.span.start_s, st.span.end_s, st.side, 0.0f, &again, &v1, &v2);
       if (v1 <= th.idle_speed_m_s || v2 <= th.idle_speed_m_s ||
           std::abs(st.turn_rad) >= 0.5f * th.steady_turn_rad) {
         continue;

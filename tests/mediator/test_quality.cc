@@ -154,8 +154,9 @@ TEST(Quality, CorridorWithTheSubject16Clips) {
 // A library of one stop take alone (CMU 16_33: slow walk, stop): it has no steady stride, so its
 // cycle is its steadiest step and that step's mirror image, trusted with foot locks (not played as
 // naive plays it). A plaza crowd at walking speed then keeps its support feet planted. Not yet
-// within the bounds: limb pops (the take's slow walk is played faster than captured, and its
-// reference accelerations are a slow walk's; bench/quality.md has the figures).
+// within the bounds: limb pops, about 90 per agent-minute (the take's slow walk is played faster
+// than captured, and its reference accelerations are a slow walk's; `gaitkeeper bench --scenario
+// plaza --clips cmu_16_33_slow_walk_stop_mrl30.bvh` gives the figures).
 TEST(Quality, PlazaWithOneStopTakeAlone) {
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
   auto lib = test::load_data_library({"clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh"});
