@@ -53,13 +53,19 @@ void decay_offset(FootLock& s, const FootLockParams& p, float dt) {
 
 void plant(FootLock& s, const FootLockInput& in) {
   // Pinned no higher than it is drawn (a pinned toe never rises) nor than the clip has it, and
-  // never below the floor; a foot drawn above that settles down onto it.
+  // never below the floor; a foot drawn above the clip's toe settles down onto it. Above means
+  // last frame's drawn toe against last frame's clip toe: the clip's toe may drop a centimetre or
+  // more in the frame the foot lands (the ball slapping down off the heel), and a pin held at last
+  // frame's height would lift the ankle by that much against a nearly straight leg, the knee
+  // snapping bent.
   const glm::vec3 at = in.fresh ? in.anim_toe : in.drawn_toe_prev;
   const float drawn_y = at.y;
   const float y = std::max(in.floor_toe_m, std::min(drawn_y, in.anim_toe.y));
   s.state = FootLockState::kLocked;
   s.target = glm::vec3(at.x, y, at.z);
-  s.offset = glm::vec3(0.0f, std::max(0.0f, drawn_y - y), 0.0f);
+  float above = std::max(0.0f, drawn_y - y);
+  if (!in.fresh) above = std::min(above, std::max(0.0f, in.drawn_toe_prev.y - in.anim_toe_prev.y));
+  s.offset = glm::vec3(0.0f, above, 0.0f);
   s.offset_vel = glm::vec3(0.0f);
 }
 

@@ -125,8 +125,9 @@ glm::vec3 advance_foot_lock(FootLock& state, const FootLockInput& in, const Foot
 FootLock fresh_foot_lock(const glm::vec3& anim_toe);
 
 // Pins the foot where it was drawn last frame (the clip's toe on a fresh frame), no higher than
-// drawn nor than the clip has it and never below the floor; a foot drawn above that settles onto
-// it through the offset. Expects usable input (step_foot_lock replaces what is not).
+// drawn nor than the clip has it and never below the floor; as far as it was drawn above the
+// clip's toe last frame, it settles onto the pin through the offset. Expects usable input
+// (step_foot_lock replaces what is not).
 FootLock plant_foot(const FootLock& state, const FootLockInput& in);
 
 // Starts a re-planting step of a pinned foot from where it is drawn (from): used when the leg

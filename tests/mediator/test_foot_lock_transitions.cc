@@ -165,6 +165,22 @@ TEST(FootLockTransition, PlantPinsWhereTheFootWasDrawn) {
   EXPECT_EQ(plant_foot(FootLock{}, in).offset, glm::vec3(0.0f));
 }
 
+// A foot drawn with the clip's toe lands as the clip's toe drops 1.4 cm in one frame (the ball
+// slapping down off the heel): pinned at the clip's toe, with no settling offset. Held at last
+// frame's height, it would lift the ankle 1.4 cm against a nearly straight leg.
+TEST(FootLockTransition, APlantFollowsTheClipsToeDownInTheFrameItLands) {
+  const glm::vec3 prev(0.40f, 0.095f, -0.20f);
+  FootLockInput in = input({0.41f, 0.081f, -0.19f}, prev, prev);
+  in.plant = in.hold = true;
+  const FootLock pinned = plant_foot(FootLock{}, in);
+  EXPECT_EQ(pinned.state, FootLockState::kLocked);
+  EXPECT_EQ(pinned.target, glm::vec3(0.40f, 0.081f, -0.20f));
+  EXPECT_EQ(pinned.offset, glm::vec3(0.0f));
+  // Drawn 2 cm above the clip last frame: those 2 cm (not the 3.4 to the clip's toe now) settle.
+  in.drawn_toe_prev.y = prev.y + 0.02f;
+  EXPECT_NEAR(plant_foot(FootLock{}, in).offset.y, 0.02f, 1e-6f);
+}
+
 TEST(FootLockTransition, ReleasingFootReplantsAtTheDrawnPositionAndSettles) {
   // Mid-release (the offset half shed), the clips plant the foot again and its ball is at rest:
   // it is pinned where it was drawn last frame, and the 1 cm it was drawn above the clip's toe
