@@ -40,9 +40,18 @@ void sanitise(FootLockInput& out) {
 // more than the arithmetic. The public functions at the end keep their value form.
 
 // A pinned toe follows the clip's toe down onto the floor as the foot rolls from the heel onto
-// the ball, and never up again while the ball bears weight (the heel rises about it).
-void lower_pin(FootLock& s, const FootLockInput& in) {
-  s.target.y = std::min(s.target.y, std::max(in.floor_toe_m, in.anim_toe.y));
+// the ball. It rises with the clip's only while the other foot is pinned: that one carries the
+// weight, and this one pivots onto its toes to push off; alone on the ground, the ball bears the
+// weight and stays down (the heel rises about it). It rises through the settling offset, so the
+// drawn toe lifts smoothly rather than jumping to the clip's height.
+void pin_height(FootLock& s, const FootLockInput& in) {
+  const float clip_y = std::max(in.floor_toe_m, in.anim_toe.y);
+  if (in.other_locked && clip_y > s.target.y) {
+    s.offset.y -= clip_y - s.target.y;
+    s.target.y = clip_y;
+    return;
+  }
+  s.target.y = std::min(s.target.y, clip_y);
 }
 
 // The offset of a foot that is not being released decays toward zero (Holden's decay spring:
@@ -117,7 +126,7 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
         // and the foot's rest against the clip's speed is carried on and shed (inertialization),
         // so the drawn foot sets off from rest: taking the clip's lift-off speed at once, the
         // knee of a leg stretched to its pin would snap.
-        lower_pin(s, in);
+        pin_height(s, in);
         release(s, s.target + s.offset, glm::vec3(0.0f), in.anim_toe_prev, anim_vel);
         return;
       }
@@ -125,7 +134,7 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
       // one foot at a time (walking, its own swing comes and takes the offset).
       const float drift = ground_length(s.target.x - in.anim_toe.x, s.target.z - in.anim_toe.z);
       if (drift > p.step_distance_m && in.other_locked && !in.walking) {
-        lower_pin(s, in);
+        pin_height(s, in);
         start_step(s, s.target + s.offset);
       }
       // Otherwise the pin is kept as it is (pinned_foot lowers it below).
@@ -149,7 +158,7 @@ glm::vec3 free_foot(const FootLock& s, const FootLockInput& in) { return in.anim
 
 // A pinned foot is drawn at its pin (lowered onto the clip's toe) plus the settling offset.
 glm::vec3 pinned_foot(FootLock& s, const FootLockInput& in) {
-  lower_pin(s, in);
+  pin_height(s, in);
   return s.target + s.offset;
 }
 

@@ -147,6 +147,44 @@ TEST(FootLockTransition, LockedFootStaysAtItsPinAndOnlyComesDown) {
   }
 }
 
+// Pushing off: the other foot pinned (it carries the weight), the clip lifts this ball by 1 cm a
+// frame. The pinned toe rises with it, smoothly: never faster than the clip's (the rise goes
+// through the settling offset), never ahead of it, and within a millimetre of it 0.3 s after the
+// clip stops rising; x and z stay pinned. The same lift with the other foot in the air leaves
+// the ball on its pin (alone on the ground, it bears the weight).
+TEST(FootLockTransition, APinnedToeRisesWithTheClipsOnlyWhileTheOtherFootIsPinned) {
+  const FootLockParams p;
+  const glm::vec3 pin(0.2f, kFloor, 0.1f);
+  for (const bool other_pinned : {true, false}) {
+    FootLock s = locked_at(pin);
+    glm::vec3 anim = pin;
+    float last_y = pin.y;
+    for (int f = 1; f <= 30; ++f) {
+      const glm::vec3 prev = anim;
+      if (f <= 6) anim.y += 0.01f;
+      FootLockInput in = input(anim, prev, s.last_goal);
+      in.hold = true;
+      in.other_locked = other_pinned;
+      const FootLockStep next = step_foot_lock(s, in, p, kDt);
+      ASSERT_EQ(next.state.state, FootLockState::kLocked) << f;
+      EXPECT_EQ(next.goal.x, pin.x) << f;
+      EXPECT_EQ(next.goal.z, pin.z) << f;
+      if (other_pinned) {
+        EXPECT_GE(next.goal.y, last_y - 1e-6f) << f;
+        EXPECT_LE(next.goal.y - last_y, 0.01f + 1e-6f) << f;
+        EXPECT_LE(next.goal.y, anim.y + 1e-6f) << f;
+      } else {
+        EXPECT_EQ(next.goal.y, pin.y) << f;
+      }
+      last_y = next.goal.y;
+      s = next.state;
+    }
+    if (other_pinned) {
+      EXPECT_NEAR(last_y, anim.y, 1e-3f);
+    }
+  }
+}
+
 TEST(FootLockTransition, PlantPinsWhereTheFootWasDrawn) {
   // plant_foot alone: drawn last at D (5 cm up), the clip's toe at 3 cm, the floor at 2 cm: the pin
   // is D's x, z at min(5, 3) = 3 cm, and the 2 cm it was drawn above that is the settling offset.
