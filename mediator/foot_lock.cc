@@ -42,12 +42,14 @@ void sanitise(FootLockInput& out) {
 // A pinned toe follows the clip's toe down onto the floor as the foot rolls from the heel onto
 // the ball. It rises with the clip's only while the other foot is pinned: that one carries the
 // weight, and this one pivots onto its toes to push off; alone on the ground, the ball bears the
-// weight and stays down (the heel rises about it). It rises through the settling offset, so the
-// drawn toe lifts smoothly rather than jumping to the clip's height.
+// weight and stays down (the heel rises about it). It rises as fast as the clip's does this frame;
+// what it has to catch up beyond that (the clip's toe already higher when the other foot is
+// pinned) goes through the settling offset, so the drawn toe never jumps.
 void pin_height(FootLock& s, const FootLockInput& in) {
   const float clip_y = std::max(in.floor_toe_m, in.anim_toe.y);
   if (in.other_locked && clip_y > s.target.y) {
-    s.offset.y -= clip_y - s.target.y;
+    const float clip_rise = std::max(0.0f, in.anim_toe.y - in.anim_toe_prev.y);
+    s.offset.y -= std::max(0.0f, clip_y - s.target.y - clip_rise);
     s.target.y = clip_y;
     return;
   }
