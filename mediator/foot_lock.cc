@@ -176,12 +176,14 @@ glm::vec3 releasing_foot(FootLock& s, const FootLockInput& in, const FootLockPar
       s.release_time_s = std::max(s.release_time_s, 1.5f * across / p.swing_speed_m_s);
     }
   }
-  // A progress that went back, as when the blend changes clips, restarts the count from there:
-  // never a jump.
-  if (s.swing_from < 0.0f || in.swing_progress + 0.05f < s.swing_from) {
+  // A progress that went back, or leapt forward by more than a swing advances in a frame, as when
+  // the blend changes clips, restarts the count from there: never a jump.
+  const bool leapt = s.swing_from >= 0.0f && in.swing_progress > s.last_progress + 0.25f;
+  if (s.swing_from < 0.0f || in.swing_progress + 0.05f < s.swing_from || leapt) {
     s.swing_from = std::min(in.swing_progress, 0.9f);
     s.shed_from = s.shed_goal;
   }
+  s.last_progress = in.swing_progress;
   const float u = (in.swing_progress - s.swing_from) / (1.0f - s.swing_from);
   s.shed_goal = std::max(s.shed_goal, s.shed_from + (1.0f - s.shed_from) * smoothstep01(u));
   // A release late in the swing still takes its time (twice the halflife at least), not a frame

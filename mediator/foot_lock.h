@@ -47,6 +47,7 @@ struct FootLock {
   glm::vec3 goal_vel{0.0f};    // its velocity [m/s] (a step turned release keeps its speed)
   float shed = 0.0f;           // releasing: share of the release offset shed so far, 0..1
   float swing_from = 0.0f;     // releasing: the swing progress at release
+  float last_progress = 0.0f;  // releasing: the swing progress last frame
   float shed_from = 0.0f;      // releasing: share shed when that progress was taken
   float shed_goal = 0.0f;      // releasing: share the swing's progress asks for
   float released_s = 0.0f;     // releasing: time since the release [s]

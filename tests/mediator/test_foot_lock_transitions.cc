@@ -321,6 +321,32 @@ TEST(FootLockTransition, ReleaseShedsTheOffsetOverTheSwingWithNoJump) {
       << "free: the clip's toe, the carried rest still decaying";
 }
 
+// The blend changes clips mid-swing and the swing's progress leaps from 0.13 to 0.55 in a frame
+// (a quarter of a swing is more than any swing advances in one): the offset is not shed in a
+// jump but from there over the rest of the swing; the foot moves on no faster than it did.
+TEST(FootLockTransition, ALeapInTheSwingsProgressShedsNoOffsetAtOnce) {
+  FootLockParams p;
+  FootLock s = release_foot_lock(FootLock{}, {0.0f, kFloor, 0.0f}, glm::vec3(0.0f),
+                                 {0.2f, kFloor, 0.0f}, glm::vec3(0.0f));
+  const glm::vec3 anim(0.2f, kFloor + 0.05f, 0.0f);
+  float progress = 0.0f, last_step = 0.0f;
+  glm::vec3 last_goal(0.0f, kFloor, 0.0f);
+  for (int f = 1; f <= 14; ++f) {
+    progress = f == 10 ? 0.55f : progress + 0.013f;
+    FootLockInput in = input(anim, anim, last_goal);
+    in.swing_progress = progress;
+    const FootLockStep next = step_foot_lock(s, in, p, kDt);
+    ASSERT_EQ(next.state.state, FootLockState::kReleasing) << f;
+    const float step = std::abs(next.goal.x - last_goal.x);
+    if (f == 10) {
+      EXPECT_LE(step, 1.5f * last_step + 1e-4f) << "a leap of the progress";
+    }
+    last_step = step;
+    last_goal = next.goal;
+    s = next.state;
+  }
+}
+
 TEST(FootLockTransition, LateReleaseStillTakesTwiceTheHalflife) {
   // Released at 90 % of the swing, landing (progress 1) on the next frame: the swing asks for all
   // of it at once, so the time bound rules: shed = smoothstep((k + 1) dt / 0.12 s), free once
