@@ -13,10 +13,11 @@
 namespace gk {
 namespace {
 
-// Rest pose positions (model space) and the plane the body is mirrored in at rest: through the
+// Rest pose positions and orientations (model space) and the plane the body is mirrored in at rest: through the
 // hips' middle, normal along the right-to-left hip line.
 struct RestFrame {
   std::vector<glm::vec3> position;
+  std::vector<glm::quat> rotation;
   glm::vec3 centre{0.0f};
   glm::vec3 normal{1.0f, 0.0f, 0.0f};
   float leg_m = 1.0f;
@@ -28,7 +29,10 @@ RestFrame rest_frame(const Skeleton& sk) {
   std::vector<glm::mat4> model(static_cast<size_t>(nj));
   LocalToModelJob{&sk, sk.rest_rotations, sk.rest_translations, glm::mat4(1.0f), model}.run();
   RestFrame r;
-  for (const glm::mat4& m : model) r.position.push_back(translation_of(m));
+  for (const glm::mat4& m : model) {
+    r.position.push_back(translation_of(m));
+    r.rotation.push_back(glm::normalize(glm::quat_cast(glm::mat3(m))));
+  }
   r.depth.assign(static_cast<size_t>(nj), 0);
   for (int j = 0; j < nj; ++j) {
     if (sk.parents[j] >= 0) r.depth[j] = r.depth[sk.parents[j]] + 1;
@@ -156,10 +160,7 @@ Clip mirror_clip(const Clip& clip, const Skeleton& sk, const std::vector<int16_t
   if (clip.num_joints != nj || static_cast<int>(map.size()) != nj || nj == 0) return out;
   const glm::vec3 n = glm::length(normal) > 1e-6f ? glm::normalize(normal) : glm::vec3(1, 0, 0);
   const RestFrame rf = rest_frame(sk);
-  std::vector<glm::mat4> rest(static_cast<size_t>(nj));
-  LocalToModelJob{&sk, sk.rest_rotations, sk.rest_translations, glm::mat4(1.0f), rest}.run();
-  std::vector<glm::quat> rest_q(static_cast<size_t>(nj));
-  for (int j = 0; j < nj; ++j) rest_q[j] = glm::normalize(glm::quat_cast(glm::mat3(rest[j])));
+  const std::vector<glm::quat>& rest_q = rf.rotation;
   // The rest pose is symmetric about the body's own middle plane (normal n0 in model space), so a
   // joint's turn away from rest is mirrored there; the reflection asked for is that one followed
   // by the rotation taking one plane onto the other (two reflections make a rotation) and a shift.

@@ -80,6 +80,44 @@ float seam_cost(const Clip& c, int a, int b) {
   return cost;
 }
 
+// Per joint, the side of the leg it belongs to (a descendant of that hip), or -1.
+std::vector<int> leg_sides(const Skeleton& sk) {
+  std::vector<int> leg(static_cast<size_t>(sk.num_joints()), -1);
+  for (int j = 0; j < sk.num_joints(); ++j) {
+    for (int s = 0; s < 2; ++s) {
+      for (int q = j; q >= 0; q = sk.parents[q]) {
+        if (q == sk.hip(static_cast<Side>(s))) leg[j] = s;
+      }
+    }
+  }
+  return leg;
+}
+
+// 0 -> 1 with zero slope at both ends (u clamped to [0, 1]).
+float smooth01(float u) {
+  u = std::clamp(u, 0.0f, 1.0f);
+  return u * u * (3.0f - 2.0f * u);
+}
+
+// The hips' position (model space, with the clip's root motion) on one frame.
+glm::vec3 clip_hips(const Clip& c, const Skeleton& sk, int frame) {
+  std::vector<glm::mat4> model(sk.num_joints());
+  clip_frame_model(c, sk, frame, model);
+  return translation_of(model[std::max(sk.role(JointRole::kHips), 0)]);
+}
+
+// A clip named and timed as the take, with no frames yet.
+Clip clip_like(const Clip& take, int frames, bool loops) {
+  Clip c;
+  c.name = take.name;
+  c.source = take.source;
+  c.fps = take.fps;
+  c.num_frames = frames;
+  c.num_joints = take.num_joints;
+  c.loops = loops;
+  return c;
+}
+
 // Frames on either side of a take's edge that contact analysis cannot trust: a contact cut by the
 // first frame did not start there.
 bool starts_inside(const TimeInterval& c, float fps) { return c.start_s > 0.5f / fps; }
@@ -161,7 +199,9 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
   std::sort(out.strides.begin(), out.strides.end(),
             [](const Stride& x, const Stride& y) { return x.span.start_s < y.span.start_s; });
   // Steps: from each contact start of a foot to the other foot's next, with no contact start of
-  // the first foot between them; measured as strides are.
+  // the first foot between them; measured as strides are. A step walks when both its halves move
+  // faster than standing and it turns less than half a steady stride does.
+  std::vector<std::pair<Stride, bool>> steps;
   for (int s = 0; s < 2; ++s) {
     for (const TimeInterval& c : a.contacts[s]) {
       if (!starts_inside(c, fps)) continue;
@@ -177,11 +217,16 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
       if (again || dur < 0.5f * th.min_stride_s || dur > 0.5f * th.max_stride_s) continue;
       Stride st;
       float v1 = 0.0f, v2 = 0.0f;
-      if (measure(t0, t1, s, 0.5f * th.steady_turn_rad, &st, &v1, &v2)) out.steps.push_back(st);
+      if (!measure(t0, t1, s, 0.5f * th.steady_turn_rad, &st, &v1, &v2)) continue;
+      const bool walks = v1 > th.idle_speed_m_s && v2 > th.idle_speed_m_s &&
+                         std::abs(st.turn_rad) < 0.5f * th.steady_turn_rad;
+      steps.emplace_back(st, walks);
     }
   }
-  std::sort(out.steps.begin(), out.steps.end(),
-            [](const Stride& x, const Stride& y) { return x.span.start_s < y.span.start_s; });
+  std::sort(steps.begin(), steps.end(), [](const auto& x, const auto& y) {
+    return x.first.span.start_s < y.first.span.start_s;
+  });
+  for (const auto& [st, walks] : steps) out.steps.push_back(st);
 
   // Per-frame labels: steady where a steady stride covers the frame; idle where the root stands;
   // the rest is told apart per run (start, stop, turn, transition).
@@ -298,15 +343,9 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
     out.fallback_cycle = true;
     // The steadiest step that walks (both halves faster than standing, a turn no bigger than half
     // a steady stride's): with its mirror image, a stride of one pace.
-    for (size_t i = 0; i < out.steps.size(); ++i) {
-      const Stride& st = out.steps[i];
-      Stride again;
-      float v1 = 0.0f, v2 = 0.0f;
-      measure(st.span.start_s, st.span.end_s, st.side, 0.0f, &again, &v1, &v2);
-      if (v1 <= th.idle_speed_m_s || v2 <= th.idle_speed_m_s ||
-          std::abs(st.turn_rad) >= 0.5f * th.steady_turn_rad) {
-        continue;
-      }
+    for (size_t i = 0; i < steps.size(); ++i) {
+      const auto& [st, walks] = steps[i];
+      if (!walks) continue;
       if (out.mirror_step < 0 ||
           std::abs(st.speed_change) < std::abs(out.steps[out.mirror_step].speed_change)) {
         out.mirror_step = static_cast<int>(i);
@@ -348,13 +387,7 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
   const int a = frame_at(stride.span.start_s, fps, n);
   const int b = frame_at(stride.span.end_s, fps, n);
   const int len = std::max(1, b - a);
-  Clip c;
-  c.name = take.name;
-  c.source = take.source;
-  c.fps = fps;
-  c.num_frames = len;
-  c.num_joints = nj;
-  c.loops = true;
+  Clip c = clip_like(take, len, true);
   // Frames a..b: the stride and the frame that closes it (where the loop must come back to).
   std::vector<glm::quat> rot(take.frame_rotations(a),
                              take.frame_rotations(a) + static_cast<size_t>(len + 1) * nj);
@@ -401,14 +434,7 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
     // 2. Closing the loop: frame len must become frame 0 again. Each joint's mismatch is taken up
     //    gradually: a leg's joints only while that foot swings (a planted foot never moves for
     //    it), the rest of the body over the whole stride.
-    std::vector<int> leg(nj, -1);
-    for (int j = 0; j < nj; ++j) {
-      for (int s = 0; s < 2; ++s) {
-        for (int q = j; q >= 0; q = sk.parents[q]) {
-          if (q == sk.hip(static_cast<Side>(s))) leg[j] = s;
-        }
-      }
-    }
+    const std::vector<int> leg = leg_sides(sk);
     int swing_from[2] = {0, 0}, swing_to[2] = {len, len};
     for (int s = 0; s < 2; ++s) {
       std::vector<uint8_t> down(len + 1, 0);
@@ -433,10 +459,6 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
         k = e + 1;
       }
     }
-    auto smooth = [](float u) {
-      u = std::clamp(u, 0.0f, 1.0f);
-      return u * u * (3.0f - 2.0f * u);
-    };
     for (int j = 0; j < nj; ++j) {
       glm::quat diff = R(0, j) * glm::inverse(R(len, j));
       if (diff.w < 0.0f) diff = -diff;
@@ -445,7 +467,7 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
         float w = static_cast<float>(k) / len;
         if (leg[j] >= 0) {
           const int s = leg[j];
-          w = smooth(static_cast<float>(k - swing_from[s]) /
+          w = smooth01(static_cast<float>(k - swing_from[s]) /
                      std::max(1, swing_to[s] - swing_from[s]));
         }
         R(k, j) = glm::normalize(glm::slerp(glm::quat(1, 0, 0, 0), diff, w) * R(k, j));
@@ -468,6 +490,17 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
   c.rotations.assign(rot.begin(), rot.begin() + static_cast<size_t>(len) * nj);
   c.translations.assign(tra.begin(), tra.begin() + static_cast<size_t>(len) * nj);
   return c;
+}
+
+TravelPlane travel_plane(const Clip& clip, const Skeleton& sk) {
+  TravelPlane plane;
+  if (clip.num_frames < 1 || !sk.has_locomotion_roles()) return plane;
+  const TakeTrack tr = track_take(clip, sk);
+  const float facing = 0.5f * (tr.facing.front() + tr.facing.back());
+  const glm::vec2 mid = 0.5f * (tr.hips.front() + tr.hips.back());
+  plane.point = glm::vec3(mid.x, 0.0f, mid.y);
+  plane.normal = glm::vec3(std::cos(facing), 0.0f, -std::sin(facing));
+  return plane;
 }
 
 MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
@@ -506,24 +539,13 @@ MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& sk, const
   // the hips' path: their sway to either side is mirrored onto the other), moved on to where the
   // step ends.
   const Clip step_clip = extract_span(take, step.span);  // frames a..b
-  const TakeTrack tr = track_take(step_clip, sk);
-  const float facing = 0.5f * (tr.facing.front() + tr.facing.back());
-  const glm::vec3 lateral(std::cos(facing), 0.0f, -std::sin(facing));
-  const glm::vec2 mid = 0.5f * (tr.hips.front() + tr.hips.back());
-  const Clip mirrored =
-      mirror_clip(step_clip, sk, mirror_map, glm::vec3(mid.x, 0.0f, mid.y), lateral);
-  const TakeTrack mt = track_take(mirrored, sk);
-  const glm::vec2 shift = tr.hips.back() - mt.hips.front();
+  const TravelPlane plane = travel_plane(step_clip, sk);
+  const Clip mirrored = mirror_clip(step_clip, sk, mirror_map, plane.point, plane.normal);
+  const glm::vec3 end = clip_hips(step_clip, sk, len), start = clip_hips(mirrored, sk, 0);
+  const glm::vec2 shift(end.x - start.x, end.z - start.z);
   // The two as one take: frames 0..len the step, len..2 len its mirror (its first frame is the
   // step's last).
-  const int frames = 2 * len + 1;
-  Clip both;
-  both.name = take.name;
-  both.source = take.source;
-  both.fps = fps;
-  both.num_frames = frames;
-  both.num_joints = nj;
-  both.loops = false;
+  Clip both = clip_like(take, 2 * len + 1, false);
   both.rotations.assign(step_clip.rotations.begin(), step_clip.rotations.end());
   both.translations.assign(step_clip.translations.begin(), step_clip.translations.end());
   for (int k = 1; k <= len; ++k) {
@@ -544,18 +566,7 @@ MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& sk, const
   // The join at frame len: the step ends as the mirror would begin. y's leg takes its mismatch up
   // while it swings into its landing (before the join); x's leg while it swings in the mirror
   // (after it); the rest of the body over the mirrored step.
-  std::vector<int> leg(nj, -1);
-  for (int j = 0; j < nj; ++j) {
-    for (int s = 0; s < 2; ++s) {
-      for (int q = j; q >= 0; q = sk.parents[q]) {
-        if (q == sk.hip(static_cast<Side>(s))) leg[j] = s;
-      }
-    }
-  }
-  auto smooth = [](float u) {
-    u = std::clamp(u, 0.0f, 1.0f);
-    return u * u * (3.0f - 2.0f * u);
-  };
+  const std::vector<int> leg = leg_sides(sk);
   for (int j = 0; j < nj; ++j) {
     const glm::quat at_join = R(len, j);
     const glm::vec3 at_join_t = T(len, j);
@@ -567,7 +578,7 @@ MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& sk, const
       if (diff.w < 0.0f) diff = -diff;
       const glm::vec3 dt = mirror_first_t - at_join_t;
       for (int k = lift_y + 1; k <= len; ++k) {
-        const float w = smooth(static_cast<float>(k - lift_y) / static_cast<float>(len - lift_y));
+        const float w = smooth01(static_cast<float>(k - lift_y) / static_cast<float>(len - lift_y));
         R(k, j) = glm::normalize(glm::slerp(glm::quat(1, 0, 0, 0), diff, w) * R(k, j));
         T(k, j) += w * dt;
       }
@@ -581,7 +592,7 @@ MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& sk, const
       float w = 1.0f - static_cast<float>(k - len) / static_cast<float>(len);
       if (leg[j] == x) {
         const int from = len + lift_y;  // x's swing in the mirror: as y's in the step
-        w = 1.0f - smooth(static_cast<float>(k - from) / static_cast<float>(2 * len - from));
+        w = 1.0f - smooth01(static_cast<float>(k - from) / static_cast<float>(2 * len - from));
       }
       R(k, j) = glm::normalize(glm::slerp(glm::quat(1, 0, 0, 0), diff, w) * R(k, j));
       T(k, j) += w * dt;
@@ -622,13 +633,7 @@ Clip extract_span(const Clip& take, TimeInterval span) {
   const int n = take.num_frames, nj = take.num_joints;
   const int a = frame_at(span.start_s, take.fps, n);
   const int b = std::max(a, frame_at(span.end_s, take.fps, n));
-  Clip c;
-  c.name = take.name;
-  c.source = take.source;
-  c.fps = take.fps;
-  c.num_frames = b - a + 1;
-  c.num_joints = nj;
-  c.loops = false;
+  Clip c = clip_like(take, b - a + 1, false);
   c.rotations.assign(take.frame_rotations(a), take.frame_rotations(b) + nj);
   c.translations.assign(take.frame_translations(a), take.frame_translations(b) + nj);
   return c;

@@ -82,12 +82,21 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& skeleton, const 
 Clip extract_cycle(const Clip& take, const Skeleton& skeleton, const ClipAnalysis& analysis,
                    const Stride& stride);
 
+// The vertical plane a stretch of a take travels along: through the middle of its hips' way
+// (their sway to either side falls on both sides of it), along the body's mean facing. The
+// plane a step or a stop is mirrored in, so that its mirror image travels the same way.
+struct TravelPlane {
+  glm::vec3 point{0.0f};
+  glm::vec3 normal{1.0f, 0.0f, 0.0f};  // horizontal, unit
+};
+TravelPlane travel_plane(const Clip& clip, const Skeleton& skeleton);
+
 // A loop made of one step of the take and its mirror image (the other foot's step, as the first
 // foot's was): for a take with no steady stride, where one step is good and the next is not (a
-// stop, a sudden stop). The step is reflected in the vertical plane along its travel, joints
-// exchanged by `mirror_map` (mirror_joint_map), and placed where the step ends; the joins are
-// closed as extract_cycle closes a stride's seam (a leg's mismatch taken up while that foot swings,
-// the body's over the step). `contacts`: each foot's contacts in the loop's time, from the take's
+// stop, a sudden stop). The step is reflected in its travel_plane, joints exchanged by
+// `mirror_map` (mirror_joint_map), and placed where the step ends; the joins are closed as
+// extract_cycle closes a stride's seam (a leg's mismatch taken up while that foot swings, the
+// body's over the step). `contacts`: each foot's contacts in the loop's time, from the take's
 // contacts of the step (a stance running through the loop's end goes on past its duration, as
 // clip analysis gives a loop's); they alternate by construction.
 struct MirroredCycle {

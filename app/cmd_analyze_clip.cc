@@ -43,18 +43,24 @@ nlohmann::json intervals_json(const std::vector<TimeInterval>& v) {
 
 constexpr float kDeg = 180.0f / std::numbers::pi_v<float>;
 
-nlohmann::json segmentation_json(const TakeSegmentation& seg) {
-  nlohmann::json strides = nlohmann::json::array();
-  for (const Stride& st : seg.strides) {
-    strides.push_back({{"start_s", st.span.start_s},
-                       {"end_s", st.span.end_s},
-                       {"foot", st.side == 0 ? "left" : "right"},
-                       {"speed_m_s", st.speed_m_s},
-                       {"speed_change", st.speed_change},
-                       {"turn_deg", st.turn_rad * kDeg},
-                       {"direction_deg", st.direction_rad * kDeg},
-                       {"steady", st.steady}});
+// Strides and steps alike: span, the foot down first, speed, speed change, turn, direction.
+nlohmann::json strides_json(const std::vector<Stride>& v) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Stride& st : v) {
+    out.push_back({{"start_s", st.span.start_s},
+                   {"end_s", st.span.end_s},
+                   {"foot", st.side == 0 ? "left" : "right"},
+                   {"speed_m_s", st.speed_m_s},
+                   {"speed_change", st.speed_change},
+                   {"turn_deg", st.turn_rad * kDeg},
+                   {"direction_deg", st.direction_rad * kDeg},
+                   {"steady", st.steady}});
   }
+  return out;
+}
+
+nlohmann::json segmentation_json(const TakeSegmentation& seg) {
+  const nlohmann::json strides = strides_json(seg.strides);
   nlohmann::json segments = nlohmann::json::array();
   for (const TakeSegment& s : seg.segments) {
     nlohmann::json j = {{"kind", segment_kind_name(s.kind)},
@@ -67,18 +73,8 @@ nlohmann::json segmentation_json(const TakeSegmentation& seg) {
     if (s.cycle >= 0) j["cycle_stride"] = s.cycle;
     segments.push_back(std::move(j));
   }
-  nlohmann::json steps = nlohmann::json::array();
-  for (const Stride& st : seg.steps) {
-    steps.push_back({{"start_s", st.span.start_s},
-                     {"end_s", st.span.end_s},
-                     {"foot", st.side == 0 ? "left" : "right"},
-                     {"speed_m_s", st.speed_m_s},
-                     {"speed_change", st.speed_change},
-                     {"turn_deg", st.turn_rad * kDeg},
-                     {"steady", st.steady}});
-  }
   return {{"strides", strides},
-          {"steps", steps},
+          {"steps", strides_json(seg.steps)},
           {"segments", segments},
           {"cycles", seg.cycles},
           {"mirror_step", seg.mirror_step},

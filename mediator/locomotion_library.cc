@@ -852,36 +852,6 @@ Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, f
   return out;
 }
 
-namespace {
-
-// The vertical plane a stretch of a take travels along (through its hips where it begins, along
-// their way to where it ends; the body's facing when the stretch barely moves): the plane its
-// mirror image is reflected in, so that the mirror travels the same way.
-glm::vec3 travel_plane_point(const Clip& c, const Skeleton& sk) {
-  std::vector<glm::mat4> model(sk.num_joints());
-  clip_frame_model(c, sk, 0, model);
-  const glm::vec3 h = translation_of(model[std::max(sk.role(JointRole::kHips), 0)]);
-  return glm::vec3(h.x, 0.0f, h.z);
-}
-glm::vec3 travel_plane_normal(const Clip& c, const Skeleton& sk) {
-  std::vector<glm::mat4> model(sk.num_joints());
-  const int hips = std::max(sk.role(JointRole::kHips), 0);
-  clip_frame_model(c, sk, 0, model);
-  const glm::vec3 a = translation_of(model[hips]);
-  const glm::vec3 across = translation_of(model[sk.hip(Side::kLeft)]) -
-                           translation_of(model[sk.hip(Side::kRight)]);
-  clip_frame_model(c, sk, c.num_frames - 1, model);
-  const glm::vec3 b = translation_of(model[hips]);
-  glm::vec3 travel(b.x - a.x, 0.0f, b.z - a.z);
-  if (glm::length(travel) < 0.05f) travel = glm::cross(across, glm::vec3(0, 1, 0));
-  travel.y = 0.0f;
-  if (glm::length(travel) < 1e-6f) return glm::vec3(1.0f, 0.0f, 0.0f);
-  travel = glm::normalize(travel);
-  return glm::vec3(travel.z, 0.0f, -travel.x);
-}
-
-}  // namespace
-
 Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& sets) {
   if (sets.empty()) return Status::Error("clip library: no clip sets given");
   LocomotionLibrary lib;
@@ -1080,8 +1050,8 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
           // agent that slows down can begin the stop on whichever foot lands first rather than
           // wait up to a stride for one of them.
           if (mirror_map.empty()) mirror_map = mirror_joint_map(sk);
-          Clip mirrored = mirror_clip(cut, sk, mirror_map, travel_plane_point(cut, sk),
-                                      travel_plane_normal(cut, sk));
+          const TravelPlane plane = travel_plane(cut, sk);
+          Clip mirrored = mirror_clip(cut, sk, mirror_map, plane.point, plane.normal);
           mirrored.name = clip.name + " (stop, mirrored)";
           report.clips.push_back(mirrored.name);
           pending.push_back({std::move(mirrored), TransitionKind::kStop});

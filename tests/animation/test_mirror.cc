@@ -16,18 +16,11 @@
 #include "animation/mirror.h"
 #include "animation/pose_jobs.h"
 #include "animation/procedural.h"
+#include "tests/animation/joint_positions.h"
 #include "tests/test_data.h"
 
 namespace gk {
 namespace {
-
-std::vector<glm::vec3> frame_positions(const Clip& c, const Skeleton& sk, int f) {
-  std::vector<glm::mat4> model(sk.num_joints());
-  clip_frame_model(c, sk, f, model);
-  std::vector<glm::vec3> out;
-  for (const glm::mat4& m : model) out.push_back(translation_of(m));
-  return out;
-}
 
 // The partner a rig's naming gives a joint, decoded without the library's rules: a "Left"/"Right"
 // word, a ".L"/".R" or "_l"/"_r" suffix, or a one-letter side prefix before the body part
@@ -119,9 +112,9 @@ TEST(Mirror, ReflectsPositionsExactlyAndTwiceIsIdentity) {
     const Clip twice = mirror_clip(once, sk, map, point, normal);
     ASSERT_EQ(once.num_frames, c.num_frames);
     for (int f = 0; f < c.num_frames; f += 5) {
-      const std::vector<glm::vec3> p = frame_positions(c, sk, f);
-      const std::vector<glm::vec3> m = frame_positions(once, sk, f);
-      const std::vector<glm::vec3> back = frame_positions(twice, sk, f);
+      const std::vector<glm::vec3> p = test::joint_positions(c, sk, f);
+      const std::vector<glm::vec3> m = test::joint_positions(once, sk, f);
+      const std::vector<glm::vec3> back = test::joint_positions(twice, sk, f);
       for (int j = 0; j < sk.num_joints(); ++j) {
         const glm::vec3 want = p[j] - 2.0f * glm::dot(p[j] - point, normal) * normal;
         EXPECT_LT(glm::length(m[map[j]] - want), 1e-4f) << c.name << " frame " << f << " "
@@ -148,8 +141,8 @@ TEST(Mirror, TheBuiltInWalkMirroredIsItselfHalfACycleOn) {
     const int hips = sk.role(JointRole::kHips);
     for (int f = 0; f < c.num_frames; ++f) {
       const int g = (f + half) % c.num_frames;
-      const std::vector<glm::vec3> a = frame_positions(m, sk, f);
-      const std::vector<glm::vec3> b = frame_positions(c, sk, g);
+      const std::vector<glm::vec3> a = test::joint_positions(m, sk, f);
+      const std::vector<glm::vec3> b = test::joint_positions(c, sk, g);
       for (int j = 0; j < sk.num_joints(); ++j) {
         const glm::vec3 pa = a[j] - glm::vec3(0.0f, 0.0f, a[hips].z);
         const glm::vec3 pb = b[j] - glm::vec3(0.0f, 0.0f, b[hips].z);

@@ -18,6 +18,7 @@
 #include "animation/mirror.h"
 #include "animation/pose_jobs.h"
 #include "animation/segmentation.h"
+#include "tests/animation/joint_positions.h"
 #include "tests/test_data.h"
 
 namespace gk {
@@ -40,14 +41,6 @@ Take load_take(const std::string& rel) {
   t.analysis = analyze_clip(t.clip(), *t.set.skeleton);
   t.seg = segment_take(t.clip(), *t.set.skeleton, t.analysis);
   return t;
-}
-
-std::vector<glm::vec3> joint_positions(const Clip& c, const Skeleton& sk, int f) {
-  std::vector<glm::mat4> model(sk.num_joints());
-  clip_frame_model(c, sk, f, model);
-  std::vector<glm::vec3> out;
-  for (const glm::mat4& m : model) out.push_back(translation_of(m));
-  return out;
 }
 
 std::vector<glm::vec3> joint_track(const Clip& c, const Skeleton& sk, int joint) {
@@ -287,8 +280,8 @@ TEST(Segmentation, AStopTakeLoopsItsSteadiestStepAndItsMirrorImage) {
     // Frame by frame, the turned take's loop is the loop turned and moved: the feet keep their
     // distance from the hips (and each other) to the millimetre.
     for (int f = 0; f < mc.loop.num_frames; ++f) {
-      const std::vector<glm::vec3> a = joint_positions(mc.loop, sk, f);
-      const std::vector<glm::vec3> b = joint_positions(tc.loop, sk, f);
+      const std::vector<glm::vec3> a = test::joint_positions(mc.loop, sk, f);
+      const std::vector<glm::vec3> b = test::joint_positions(tc.loop, sk, f);
       const int hips = sk.role(JointRole::kHips);
       for (int j = 0; j < sk.num_joints(); ++j) {
         EXPECT_NEAR(glm::length(a[j] - a[hips]), glm::length(b[j] - b[hips]), 2e-3f)
