@@ -617,14 +617,24 @@ MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& sk, const
   Stride stride = step;
   stride.span = {0.0f, 2 * len * f};
   out.loop = extract_cycle(both, sk, joined, stride);
-  // The loop's contacts: a stance through the loop's end goes on past its duration.
-  out.contacts[x] = {joined.contacts[x][0]};
-  if (lift_x < len && lift_y > 0) out.contacts[x].push_back(iv(len, len + lift_y));
-  if (lift_x >= len) {
-    out.contacts[y] = {iv(len, 2 * len + lift_y)};
-  } else {
-    if (lift_y > 0) out.contacts[y].push_back(iv(0, lift_y));
-    out.contacts[y].push_back(iv(len, len + lift_x));
+  out.contacts = stride_contacts(joined, 0, 2 * len, fps);
+  return out;
+}
+
+std::array<std::vector<TimeInterval>, 2> stride_contacts(const ClipAnalysis& take, int first,
+                                                         int frames, float fps) {
+  std::array<std::vector<TimeInterval>, 2> out;
+  const float from = first / fps, duration = frames / fps, tol = 0.5f / fps;
+  for (int s = 0; s < 2; ++s) {
+    for (const TimeInterval& c : take.contacts[s]) {
+      const float a = std::max(c.start_s - from, 0.0f), b = std::min(c.end_s - from, duration);
+      if (b - a >= 1.0f / fps) out[s].push_back({a, b});
+    }
+    std::vector<TimeInterval>& v = out[s];
+    if (v.size() >= 2 && v.front().start_s <= tol && v.back().end_s >= duration - tol) {
+      v.back().end_s = duration + v.front().end_s;
+      v.erase(v.begin());
+    }
   }
   return out;
 }

@@ -107,6 +107,14 @@ MirroredCycle extract_mirrored_cycle(const Clip& take, const Skeleton& skeleton,
                                      const ClipAnalysis& analysis, const Stride& step,
                                      const std::vector<int16_t>& mirror_map);
 
+// A take's contacts within the stride cut from it (frames `first`..`first + frames`), in the
+// loop's time: clip analysis of the whole take sees each stance with what comes before and after
+// it; the loop analysed alone does not (a stride that slows down walks at no one speed, and its
+// stance feet seem to move against the loop's mean travel). A stance that runs through the loop's
+// end goes on at its start: one interval past the duration, as clip analysis gives a loop's.
+std::array<std::vector<TimeInterval>, 2> stride_contacts(const ClipAnalysis& take, int first,
+                                                         int frames, float fps);
+
 // The take's frames from `span` as a clip that does not loop (a start, a stop, a turn).
 Clip extract_span(const Clip& take, TimeInterval span);
 

@@ -253,33 +253,39 @@ int run_analyze(const AnalyzeOptions& opt) {
       nlohmann::json j = analysis_json(set, clip, a, seg);
       // Each cycle cut out as a loop, analysed as the library will use it.
       nlohmann::json loops = nlohmann::json::array();
+      // A loop as the library will use it: its length, its own speed, direction and foot-slide
+      // floor, and the contacts it is played with.
+      auto loop_json = [&](const char* key, int index, const Clip& loop,
+                           const std::array<std::vector<TimeInterval>, 2>* contacts) {
+        const ClipAnalysis la = analyze_clip(loop, *set.skeleton);
+        const std::vector<TimeInterval>& left = contacts ? (*contacts)[0] : la.contacts[0];
+        const std::vector<TimeInterval>& right = contacts ? (*contacts)[1] : la.contacts[1];
+        nlohmann::json j = {{"frames", loop.num_frames},
+                            {"speed_m_s", la.native_speed_m_s},
+                            {"direction_deg", la.direction_rad * kDeg},
+                            {"contacts",
+                             {{"left", intervals_json(left)}, {"right", intervals_json(right)}}},
+                            {"foot_slide_floor_cm_s", la.floor.mean_cm_s}};
+        j[key] = index;
+        return j;
+      };
       if (seg.fallback_cycle && seg.mirror_step >= 0) {
         // The library's cycle: the steadiest step and its mirror image, with the step's contacts.
         const MirroredCycle mc =
             extract_mirrored_cycle(clip, *set.skeleton, a, seg.steps[seg.mirror_step],
                                    mirror_joint_map(*set.skeleton));
-        const ClipAnalysis la = analyze_clip(mc.loop, *set.skeleton);
-        loops.push_back({{"step", seg.mirror_step},
-                         {"frames", mc.loop.num_frames},
-                         {"speed_m_s", la.native_speed_m_s},
-                         {"direction_deg", la.direction_rad * kDeg},
-                         {"contacts",
-                          {{"left", intervals_json(mc.contacts[0])},
-                           {"right", intervals_json(mc.contacts[1])}}},
-                         {"foot_slide_floor_cm_s", la.floor.mean_cm_s}});
-      }
-      for (int ci : seg.cycles) {
-        if (seg.fallback_cycle && seg.mirror_step >= 0) break;
-        const Clip loop = extract_cycle(clip, *set.skeleton, a, seg.strides[ci]);
-        const ClipAnalysis la = analyze_clip(loop, *set.skeleton);
-        loops.push_back({{"stride", ci},
-                         {"frames", loop.num_frames},
-                         {"speed_m_s", la.native_speed_m_s},
-                         {"direction_deg", la.direction_rad * kDeg},
-                         {"contacts",
-                          {{"left", intervals_json(la.contacts[0])},
-                           {"right", intervals_json(la.contacts[1])}}},
-                         {"foot_slide_floor_cm_s", la.floor.mean_cm_s}});
+        loops.push_back(loop_json("step", seg.mirror_step, mc.loop, &mc.contacts));
+      } else {
+        for (int ci : seg.cycles) {
+          const Stride& st = seg.strides[ci];
+          const Clip loop = extract_cycle(clip, *set.skeleton, a, st);
+          // A steady loop keeps the take's contacts of its stride (as the library plays it); a
+          // fallback stride is analysed alone.
+          const int first = std::clamp(static_cast<int>(std::lround(st.span.start_s * clip.fps)),
+                                       0, clip.num_frames - 1);
+          const auto contacts = stride_contacts(a, first, loop.num_frames, clip.fps);
+          loops.push_back(loop_json("stride", ci, loop, seg.fallback_cycle ? nullptr : &contacts));
+        }
       }
       j["take"]["loops"] = std::move(loops);
       if (!opt.plot.empty()) plotted.push_back({&clip, set.skeleton.get(), a, seg});

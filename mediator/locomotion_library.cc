@@ -205,29 +205,6 @@ FootTracks foot_tracks(const Clip& c, const Skeleton& sk) {
   return t;
 }
 
-// A take's contacts within the stride cut from it (frames `first`..`first + frames`), in the
-// loop's time: clip analysis of the whole take sees each stance with what comes before and after
-// it; the loop analysed alone does not (a stride that slows down walks at no one speed, and its
-// stance feet seem to move against the loop's mean travel). A stance that runs through the loop's
-// end goes on at its start: one interval past the duration, as clip analysis gives a loop's.
-std::array<std::vector<TimeInterval>, 2> stride_contacts(const ClipAnalysis& take, int first,
-                                                         int frames, float fps) {
-  std::array<std::vector<TimeInterval>, 2> out;
-  const float from = first / fps, duration = frames / fps, tol = 0.5f / fps;
-  for (int s = 0; s < 2; ++s) {
-    for (const TimeInterval& c : take.contacts[s]) {
-      const float a = std::max(c.start_s - from, 0.0f), b = std::min(c.end_s - from, duration);
-      if (b - a >= 1.0f / fps) out[s].push_back({a, b});
-    }
-    std::vector<TimeInterval>& v = out[s];
-    if (v.size() >= 2 && v.front().start_s <= tol && v.back().end_s >= duration - tol) {
-      v.back().end_s = duration + v.front().end_s;
-      v.erase(v.begin());
-    }
-  }
-  return out;
-}
-
 // The in-place clip's feet move backward under the body at this velocity: added back, they stand.
 glm::vec3 travel_velocity(const LocomotionClip& lc) {
   return lc.speed_m_s * glm::vec3(std::sin(lc.direction_rad), 0.0f, std::cos(lc.direction_rad));
