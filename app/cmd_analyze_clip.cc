@@ -315,7 +315,8 @@ void add_analyze_clip_command(CLI::App& app) {
       "analyze-clip",
       "Analyse clips: unit scale, IK-style feet re-parented under the shins, native speed and "
       "direction, gait cycle, foot contacts, foot-slide floor; a take's segments (idle, start, "
-      "steady, turn, stop) and the loops cut from it.");
+      "steady, turn, stop) and the loops cut from it (without a steady stride: its steadiest "
+      "step and that step's mirror image).");
   cmd->add_option("files", opt->files,
                   "BVH, glTF or GLB files, folders of them, or 'builtin' for the built-in set")
       ->required();
@@ -328,7 +329,8 @@ void add_analyze_clip_command(CLI::App& app) {
   cmd->add_option("--plot", opt->plot,
                   "write a PNG: per clip, each toe's height and speed over time with the contacts "
                   "shaded, and the take's segments (idle, start, steady, turn, stop) with the "
-                  "loops cut out of it");
+                  "loops cut out of it (white; yellow: the step whose mirror image completes the "
+                  "loop)");
   cmd->add_flag("--json", opt->json, "print a JSON array instead of text");
   cmd->callback([opt] {
     const int code = run_analyze(*opt);

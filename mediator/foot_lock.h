@@ -1,7 +1,7 @@
 #pragma once
 // The foot-lock state machine of one foot as small pure functions (Holden's style: explicit state
 // in, state out; the caller stores it), so each transition can be tested alone. Pose synthesis runs
-// step_foot_lock per foot and turns the goal into leg IK.
+// advance_foot_lock (step_foot_lock in place) per foot and turns the goal into leg IK.
 //
 // A foot the clips put on the ground is pinned where it was drawn (plant_foot); it is held until
 // the clips lift it, then released (release_foot_lock): the difference between where it was drawn
@@ -9,7 +9,8 @@
 // (smoothly in the swing's progress, gone when the clip lands the foot), so no joint snaps, the
 // correction happens in the air, and the swing keeps the clip's own height. A foot that lands
 // settles onto the floor through a decaying offset (a critically damped spring, exact for any
-// step). A pinned foot left far behind by a turn or a drift re-plants (start_foot_step), while the
+// step). A pinned toe follows the clip's down as the foot rolls onto its ball, and up only while
+// the other foot is pinned (pushing off onto the toes). A pinned foot left far behind by a turn or a drift re-plants (start_foot_step), while the
 // other foot is pinned, with a short step as high as the clips' own swing.
 //
 //   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest, or
