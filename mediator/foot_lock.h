@@ -77,9 +77,9 @@ struct FootLockInput {
   // while the other foot may still be rolling down onto its ball: both off the ground).
   bool walking = false;
   // The other foot is in the air and coming down (walking: in the clips and not pinned yet; or in
-  // a re-planting step): this one keeps its weight (its lock) until the other has taken it over,
-  // as a trailing foot stays down until the leading one is flat. (Running has a flight phase: no
-  // such wait.)
+  // a re-planting step), or pinned on its heel and still rolling down onto its ball: this one
+  // keeps its weight (its lock) until the other has taken it over, as a trailing foot stays down
+  // until the leading one is flat. (Running has a flight phase: no such wait.)
   bool other_landing = false;
   float floor_toe_m = 0.0f;  // where planted toes are (library floor) [m]
   // A ball this slow over the ground is at rest (clip analysis's "still": half the travel speed,

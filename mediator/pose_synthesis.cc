@@ -59,8 +59,19 @@ float heel_room(const glm::vec3& d) {
   return std::max(0.0f, kMaxHeelOff - std::asin(std::clamp(d.y / len, -1.0f, 1.0f)));
 }
 
+// A foot whose ball is this much higher [rad of pitch] over its floor than its ankle is over its
+// own stands on its heel, rolling down onto the ball (a heel strike lands some 15-25 deg toe-up);
+// a flat foot, captured or not, is within a few degrees of 0.
+const float kOnHeelSin = std::sin(10.0f * kPi / 180.0f);
 constexpr float kHeelHalflife = 0.05f;    // [s] a raised heel settles back this fast
 constexpr float kHeelUpHalflife = 0.02f;  // [s] and rises this fast
+
+// True when a foot with its ankle and ball (toe) here stands on its heel: pitched toe-up by more
+// than kOnHeelSin against the pose the library plants it in (its floor heights).
+bool on_heel(const glm::vec3& ankle, const glm::vec3& toe, float ankle_floor, float toe_floor) {
+  const float rise = (toe.y - toe_floor) - (ankle.y - ankle_floor);
+  return rise > kOnHeelSin * glm::length(toe - ankle);
+}
 
 // The foot's pitch about its toe [rad] that lifts an ankle at toe + d to ankle_floor (0 when it is
 // already as high): the heel rises, the ball stays.
@@ -619,7 +630,15 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // The other foot is in the air and will come down: walking, coming down in the clips and not
     // pinned yet; or in a re-planting step (as when a standing agent sets off: the first step of
     // the clips waits until the re-planting foot is down, never both feet in the air).
-    in.other_landing = other == FootLockState::kStepping ||
+    // A trailing foot keeps its weight until the leading one is flat: pinned on its heel, the
+    // leading foot is still rolling onto its ball (the clips' toe-off may come first).
+    const Side other_side = static_cast<Side>(1 - side);
+    const bool other_on_heel =
+        other == FootLockState::kLocked && in.walking &&
+        on_heel(translation_of(world_[base + skeleton_.ankle(other_side)]),
+                translation_of(world_[base + skeleton_.toe(other_side)]),
+                library_.planted_ankle_m[1 - side], library_.planted_toe_m[1 - side]);
+    in.other_landing = other_on_heel || other == FootLockState::kStepping ||
                        (pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&
                         other_coming_down);
     in.floor_toe_m = library_.planted_toe_m[side];
