@@ -457,30 +457,41 @@ void LocalToModelJob::run() const {
   // (the sums in glm's order: the same bits). The rotation matrices of four joints at once (they
   // do not depend on the parents), each lane glm::mat3_cast's operations in its order; each joint
   // then takes its lane's entries, broadcast, straight from the registers.
-  auto parent_of = [&](int joint) -> const glm::mat4& {
-    const int parent = skeleton->parents[joint];
-    return parent < 0 ? root_transform : out_model[parent];
-  };
-  auto compose = [&](int joint, const __m128* e, auto lane) {
+  // The arrays through locals: the stores below are through may-alias vector pointers, after
+  // which members read through `this` would be loaded again for every joint.
+  const int16_t* parents = skeleton->parents.data();
+  const float* root = &root_transform[0].x;
+  float* model = &(*out_model.data())[0].x;
+  // A joint's local translation (x, y, z) in k0, k1, k2 of the three registers t holding four
+  // joints' twelve floats: broadcast from there (one pshufd each, no scalar load and shuffle).
+  auto compose = [&](int joint, const __m128* e, const __m128* t, auto lane) {
     constexpr int k = decltype(lane)::value;
     // pshufd broadcasts a lane in one instruction (shufps needs a register copy first).
     auto at = [&](int i) { return broadcast_lane<k>(e[i]); };
-    const glm::mat4& p = parent_of(joint);
-    const __m128 p0 = _mm_loadu_ps(&p[0].x), p1 = _mm_loadu_ps(&p[1].x), p2 = _mm_loadu_ps(&p[2].x),
-                 p3 = _mm_loadu_ps(&p[3].x);
+    auto tr = [&](auto c) {
+      constexpr int f = 3 * k + decltype(c)::value;
+      return broadcast_lane<f % 4>(t[f / 4]);
+    };
+    const int parent = parents[joint];
+    const float* p = parent < 0 ? root : model + 16 * parent;
+    const __m128 p0 = _mm_loadu_ps(p), p1 = _mm_loadu_ps(p + 4), p2 = _mm_loadu_ps(p + 8),
+                 p3 = _mm_loadu_ps(p + 12);
     auto column = [&](__m128 a, __m128 b, __m128 c) {
       return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
     };
-    const glm::vec3& t = translations[joint];
-    float* m = &out_model[joint][0].x;
+    float* m = model + 16 * joint;
     _mm_storeu_ps(m, column(at(0), at(1), at(2)));
     _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
     _mm_storeu_ps(m + 8, column(at(6), at(7), at(8)));
-    _mm_storeu_ps(m + 12,
-                  _mm_add_ps(column(_mm_set1_ps(t.x), _mm_set1_ps(t.y), _mm_set1_ps(t.z)), p3));
+    _mm_storeu_ps(m + 12, _mm_add_ps(column(tr(std::integral_constant<int, 0>{}),
+                                            tr(std::integral_constant<int, 1>{}),
+                                            tr(std::integral_constant<int, 2>{})),
+                                     p3));
   };
-  // The rotation matrices of the four joints from q on; the first `count` of them composed.
-  auto group = [&](int first, const glm::quat* q4, int count) __attribute__((always_inline)) {
+  // The rotation matrices of the four joints from q4 on (their translations from t4, twelve
+  // floats); the first `count` of them composed.
+  auto group = [&](int first, const glm::quat* q4, const float* t4, int count)
+      __attribute__((always_inline)) {
     const Quat4 q = load4(q4);
     const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
     const __m128 xx = _mm_mul_ps(q.x, q.x), yy = _mm_mul_ps(q.y, q.y), zz = _mm_mul_ps(q.z, q.z);
@@ -495,19 +506,28 @@ void LocalToModelJob::run() const {
                          _mm_mul_ps(two, _mm_add_ps(xz, wy)),
                          _mm_mul_ps(two, _mm_sub_ps(yz, wx)),
                          _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)))};
-    compose(first, e, std::integral_constant<int, 0>{});
-    if (count > 1) compose(first + 1, e, std::integral_constant<int, 1>{});
-    if (count > 2) compose(first + 2, e, std::integral_constant<int, 2>{});
-    if (count > 3) compose(first + 3, e, std::integral_constant<int, 3>{});
+    const __m128 t[3] = {_mm_loadu_ps(t4), _mm_loadu_ps(t4 + 4), _mm_loadu_ps(t4 + 8)};
+    compose(first, e, t, std::integral_constant<int, 0>{});
+    if (count > 1) compose(first + 1, e, t, std::integral_constant<int, 1>{});
+    if (count > 2) compose(first + 2, e, t, std::integral_constant<int, 2>{});
+    if (count > 3) compose(first + 3, e, t, std::integral_constant<int, 3>{});
   };
-  for (; j + 4 <= end; j += 4) group(j, rotations.data() + j, 4);
-  if (j < end) {
-    // The last one to three joints (partial updates are mostly such short runs: a leg's hip and
-    // knee, an ankle and its toe) padded to four with identities: a lane computes what the
-    // scalar loop would, in fewer instructions; the padding is not composed.
-    glm::quat tail[4];
-    for (int k = 0; k < 4; ++k) tail[k] = j + k < end ? rotations[j + k] : glm::quat(1, 0, 0, 0);
-    group(j, tail, end - j);
+  const glm::quat* rot = rotations.data();
+  const float* trans = &translations.data()->x;
+  for (; j + 4 <= end; j += 4) group(j, rot + j, trans + 3 * j, 4);
+  if (j < end && j + 4 <= n) {
+    // The last one to three joints of a range (partial updates are mostly such short runs: a
+    // leg's hip and knee, an ankle and its toe) with the joints after them as padding: a lane
+    // computes what the scalar loop would, in fewer instructions; the padding is not composed.
+    group(j, rot + j, trans + 3 * j, end - j);
+    j = end;
+  } else if (j < end) {  // the skeleton's last joints: padded with identities past its end
+    glm::quat tail_q[4] = {glm::quat(1, 0, 0, 0), glm::quat(1, 0, 0, 0), glm::quat(1, 0, 0, 0),
+                           glm::quat(1, 0, 0, 0)};
+    float tail_t[12] = {};
+    std::copy(rot + j, rot + end, tail_q);
+    std::copy(trans + 3 * j, trans + 3 * end, tail_t);
+    group(j, tail_q, tail_t, end - j);
     j = end;
   }
 #endif
@@ -638,15 +658,17 @@ void SkinningPaletteJob::run() const {
   }
 #if defined(__SSE2__)
   if (stream_out && reinterpret_cast<uintptr_t>(out_palette.data()) % 16 == 0) {
-    for (size_t j = 0; j < model.size(); ++j) {
-      const glm::mat4& a = model[j];
-      const glm::mat4& b = inverse_bind[j];
-      const __m128 a0 = _mm_loadu_ps(&a[0].x), a1 = _mm_loadu_ps(&a[1].x),
-                   a2 = _mm_loadu_ps(&a[2].x), a3 = _mm_loadu_ps(&a[3].x);
-      float* m = &out_palette[j][0].x;
+    // The arrays through locals: after a streamed store (may-alias) members would be read again.
+    const float* a = &(*model.data())[0].x;
+    const float* b = &(*inverse_bind.data())[0].x;
+    float* m = &(*out_palette.data())[0].x;
+    const float* const a_end = a + 16 * model.size();
+    for (; a != a_end; a += 16, b += 16, m += 16) {
+      const __m128 a0 = _mm_loadu_ps(a), a1 = _mm_loadu_ps(a + 4), a2 = _mm_loadu_ps(a + 8),
+                   a3 = _mm_loadu_ps(a + 12);
       for (int c = 0; c < 4; ++c) {
         // The column loaded once, its entries broadcast from the register.
-        const __m128 bc = _mm_loadu_ps(&b[c].x);
+        const __m128 bc = _mm_loadu_ps(b + 4 * c);
         __m128 col = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, broadcast_lane<0>(bc)),
                                            _mm_mul_ps(a1, broadcast_lane<1>(bc))),
                                 _mm_mul_ps(a2, broadcast_lane<2>(bc)));
