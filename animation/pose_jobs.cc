@@ -13,6 +13,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtx/quaternion.hpp>
 
+#include "animation/quat_sse.h"
+
 namespace gk {
 namespace {
 
@@ -621,7 +623,7 @@ void TwoBoneIKJob::run() const {
   // End joint after the bend, then swing the chain onto the target direction.
   const glm::vec3 c1 = a + r_bend * (b - a) + r_bend * (r_knee * (c - b));
   const glm::quat r_swing = rotation_between(c1 - a, target - a);
-  glm::quat r = r_swing * r_bend;
+  glm::quat r = quat_mul(r_swing, r_bend);
 
   // Twist about the start-target axis so the knee points toward the pole.
   const glm::vec3 axis_t = glm::normalize(target - a);
@@ -629,15 +631,15 @@ void TwoBoneIKJob::run() const {
   const glm::vec3 knee_p = knee - axis_t * glm::dot(knee, axis_t);
   const glm::vec3 pole_p = pole - axis_t * glm::dot(pole, axis_t);
   if (glm::length(knee_p) > 1e-5f && glm::length(pole_p) > 1e-5f) {
-    r = rotation_of_cos_sin(glm::dot(knee_p, pole_p), glm::dot(glm::cross(knee_p, pole_p), axis_t),
-                            axis_t) *
-        r;
+    r = quat_mul(rotation_of_cos_sin(glm::dot(knee_p, pole_p),
+                                     glm::dot(glm::cross(knee_p, pole_p), axis_t), axis_t),
+                 r);
   }
 
   const glm::quat qa = glm::quat_cast(glm::mat3(start_model));
   const glm::quat qb = glm::quat_cast(glm::mat3(mid_model));
-  glm::quat start_corr = glm::normalize(glm::inverse(qa) * r * qa);
-  glm::quat mid_corr = glm::normalize(glm::inverse(qb) * r_knee * qb);
+  glm::quat start_corr = conjugate_into(qa, r);
+  glm::quat mid_corr = conjugate_into(qb, r_knee);
   if (weight < 1.0f) {
     const glm::quat id(1, 0, 0, 0);
     start_corr = nlerp_shortest(id, start_corr, weight);
