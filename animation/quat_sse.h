@@ -77,6 +77,26 @@ inline glm::quat conjugate_into(const glm::quat& q, const glm::quat& r) {
 #endif
 }
 
+// glm::normalize(p * q): a rotation composed and kept unit length.
+inline glm::quat normalized_product(const glm::quat& p, const glm::quat& q) {
+#if defined(__SSE2__)
+  using namespace quat_sse;
+  return store(normalize(mul(load(p), load(q))));
+#else
+  return glm::normalize(p * q);
+#endif
+}
+
+// glm::normalize(glm::inverse(p) * q).
+inline glm::quat normalized_inverse_product(const glm::quat& p, const glm::quat& q) {
+#if defined(__SSE2__)
+  using namespace quat_sse;
+  return store(normalize(mul(inverse(load(p)), load(q))));
+#else
+  return glm::normalize(glm::inverse(p) * q);
+#endif
+}
+
 // glm's p * q.
 inline glm::quat quat_mul(const glm::quat& p, const glm::quat& q) {
 #if defined(__SSE2__)

@@ -8,6 +8,7 @@
 
 #include "animation/fast_atan2.h"
 #include "animation/pose_jobs.h"
+#include "animation/quat_sse.h"
 #include "mediator/coarse_pose.h"
 #include "mediator/springs.h"
 
@@ -580,7 +581,7 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
     const glm::mat4& m = world_[base + j];
     const glm::vec3 up = glm::normalize(glm::vec3(m[0].y, m[1].y, m[2].y));
     const glm::quat corr(c, sn * up.x, sn * up.y, sn * up.z);
-    local_rot_[base + j] = glm::normalize(local_rot_[base + j] * corr);
+    local_rot_[base + j] = normalized_product(local_rot_[base + j], corr);
   }
   fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
 }
@@ -780,8 +781,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     ik.out_start_correction = &c_hip;
     ik.out_mid_correction = &c_knee;
     ik.run();
-    local_rot_[base + hip] = glm::normalize(local_rot_[base + hip] * c_hip);
-    local_rot_[base + knee] = glm::normalize(local_rot_[base + knee] * c_knee);
+    local_rot_[base + hip] = normalized_product(local_rot_[base + hip], c_hip);
+    local_rot_[base + knee] = normalized_product(local_rot_[base + knee], c_knee);
   }
   fk_ranges(slot, use_ik[0] ? leg_above_ankle_[0] : JointRange{},
             use_ik[1] ? leg_above_ankle_[1] : JointRange{}, placed);
@@ -794,7 +795,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const int parent = skeleton_.parents[ankle];
     if (parent < 0) continue;
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
-    local_rot_[base + ankle] = glm::normalize(glm::inverse(parent_rot) * ankle_world_rot[side]);
+    local_rot_[base + ankle] = normalized_inverse_product(parent_rot, ankle_world_rot[side]);
   }
   fk_ranges(slot, use_ik[0] ? subtree(skeleton_.ankle(Side::kLeft)) : JointRange{},
             use_ik[1] ? subtree(skeleton_.ankle(Side::kRight)) : JointRange{}, placed);

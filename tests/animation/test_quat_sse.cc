@@ -46,6 +46,16 @@ TEST(QuatSse, ConjugationIsGlmsToTheBit) {
   }
 }
 
+TEST(QuatSse, NormalizedProductsAreGlmsToTheBit) {
+  std::mt19937 rng(13);
+  for (int i = 0; i < 200000; ++i) {
+    const glm::quat p = random_quat(rng), q = random_quat(rng);
+    ASSERT_TRUE(same_bits(normalized_product(p, q), glm::normalize(p * q))) << i;
+    ASSERT_TRUE(same_bits(normalized_inverse_product(p, q), glm::normalize(glm::inverse(p) * q)))
+        << i;
+  }
+}
+
 TEST(QuatSse, DegenerateInputsAsGlm) {
   const glm::quat zero(0, 0, 0, 0), id(1, 0, 0, 0), r(0.5f, 0.5f, -0.5f, 0.5f);
   const float nan = std::numeric_limits<float>::quiet_NaN();
