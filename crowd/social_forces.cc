@@ -15,6 +15,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "crowd/simd_exp.h"
 #include "crowd/spatial_grid.h"
 
 namespace gk {
@@ -262,7 +263,7 @@ void SocialForces::add_neighbour_force(const AgentTerms& a, size_t k, uint32_t m
   const float stretch = sum / (2.0f * std::max(b, 0.1f * sum + 1e-6f));
   const glm::vec2 dir = 0.5f * (n + (dy_len > 1e-6f ? dy / dy_len : n));
   const float repulsion = p.agent_strength_m_s2 *
-                          std::exp((a.radius + other.radius - b) * (1.0f / p.agent_range_m)) * w *
+                          exp1((a.radius + other.radius - b) * (1.0f / p.agent_range_m)) * w *
                           stretch;
   *acc += repulsion * dir;
   if (cos_phi > 0.0f) *acc += (p.side_step * repulsion * cos_phi) * a.right;
@@ -281,8 +282,8 @@ __m128 select(__m128 mask, __m128 if_true, __m128 if_false) {
 }
 }  // namespace
 
-// add_neighbour_force for candidates[0, count) in order, four at a time with SSE2 (the exp()
-// stays the library's, per lane). A group with a neighbour on the very same spot goes the scalar
+// add_neighbour_force for candidates[0, count) in order, four at a time with SSE2 (exp4 gives
+// each lane what exp1 gives). A group with a neighbour on the very same spot goes the scalar
 // way, which separates the pair by id.
 void SocialForces::add_neighbour_forces(const AgentTerms& a, size_t k, const uint32_t* candidates,
                                         uint32_t count, glm::vec2* acc) const {
@@ -343,11 +344,9 @@ void SocialForces::add_neighbour_forces(const AgentTerms& a, size_t k, const uin
     const __m128 uz = select(has_dy, _mm_div_ps(dyz, dy_len), nz);
     const __m128 dirx = _mm_mul_ps(half, _mm_add_ps(nx, ux));
     const __m128 dirz = _mm_mul_ps(half, _mm_add_ps(nz, uz));
-    alignas(16) float arg[4], e[4];
-    _mm_store_ps(arg, _mm_mul_ps(_mm_sub_ps(radii, b), inv_b));
-    for (uint32_t l = 0; l < 4; ++l) e[l] = std::exp(arg[l]);
+    const __m128 e = exp4(_mm_mul_ps(_mm_sub_ps(radii, b), inv_b));
     const __m128 repulsion =
-        _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(strength), _mm_load_ps(e)), w), stretch);
+        _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(strength), e), w), stretch);
     alignas(16) float rx[4], rz[4], side[4], cosv[4], contact[4], ox_n[4], oz_n[4];
     _mm_store_ps(rx, _mm_mul_ps(repulsion, dirx));
     _mm_store_ps(rz, _mm_mul_ps(repulsion, dirz));
@@ -419,7 +418,7 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
       const float dist = std::sqrt(d2);
       const glm::vec2 n = d / dist;
       const float overlap = r_i - dist;
-      acc += (p.wall_strength_m_s2 * std::exp(overlap * inv_bw)) * n;
+      acc += (p.wall_strength_m_s2 * exp1(overlap * inv_bw)) * n;
       if (overlap > 0.0f) acc += (stiffness * overlap) * n;
     }
     glm::vec2 v_new = vel + acc * dt_s;
