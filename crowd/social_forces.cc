@@ -227,83 +227,50 @@ void SocialForces::prepare(size_t begin, size_t end) {
   }
 }
 
-// The force of one neighbour (sorted index m) on an agent, added to *acc. The four-wide path
-// below computes the same IEEE operations in the same order, so either gives the same bits.
-void SocialForces::add_neighbour_force(const AgentTerms& a, size_t k, uint32_t m,
-                                       glm::vec2* acc) const {
-  const SocialForceParams& p = params_;
-  const Body& other = sorted_[m];
-  const glm::vec2 d = a.position - other.position;
-  const float d2 = glm::dot(d, d);
-  glm::vec2 n;
-  float dist;
-  if (d2 > 1e-12f) {
-    dist = std::sqrt(d2);
-    n = d / dist;
-  } else {  // same spot: separate by id so the pair pushes apart symmetrically
-    const auto order = impl_->grid.order();
-    dist = 0.0f;
-    n = glm::vec2(id_[order[k]] < id_[order[m]] ? -1.0f : 1.0f, 0.0f);
-  }
-  const float overlap = a.radius + other.radius - dist;
-  const float cos_phi = -glm::dot(n, a.facing);  // 1: the other is straight ahead
-  const float lambda = p.field_of_view_weight;
-  const float w = lambda + (1.0f - lambda) * 0.5f * (1.0f + cos_phi);
-  // Elliptical specification II (Johansson, Helbing & Shukla 2007): the distance is replaced by
-  // the semi-minor axis b of an ellipse through p_i with foci at p_j and at p_j moved by the
-  // relative velocity over the anticipation time, so agents on a collision course repel early and
-  // sideways, while agents walking alongside barely interact.
-  const glm::vec2 y = (other.velocity - a.velocity) * p.anticipation_time_s;
-  const glm::vec2 dy = d - y;
-  const float dy_len = std::sqrt(glm::dot(dy, dy));
-  const float sum = dist + dy_len;
-  const float b = 0.5f * std::sqrt(std::max(sum * sum - glm::dot(y, y), 0.0f));
-  // The potential's gradient grows as sum / 2b; capping b keeps it finite when the other is
-  // predicted to pass right through p_i.
-  const float stretch = sum / (2.0f * std::max(b, 0.1f * sum + 1e-6f));
-  const glm::vec2 dir = 0.5f * (n + (dy_len > 1e-6f ? dy / dy_len : n));
-  const float repulsion = p.agent_strength_m_s2 *
-                          exp1((a.radius + other.radius - b) * (1.0f / p.agent_range_m)) * w *
-                          stretch;
-  *acc += repulsion * dir;
-  if (cos_phi > 0.0f) *acc += (p.side_step * repulsion * cos_phi) * a.right;
-  const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
-  if (overlap > 0.0f) *acc += (stiffness * overlap) * n;
-}
-
 namespace {
-// std::max(a, b) lane by lane, ties and signed zeros included: (a < b) ? b : a.
-__m128 max_as_std(__m128 a, __m128 b) {
-  const __m128 less = _mm_cmplt_ps(a, b);
-  return _mm_or_ps(_mm_and_ps(less, b), _mm_andnot_ps(less, a));
-}
+// _mm_max_ps(lo, x) below is std::max(x, lo), NaN and signed zeros included: (x < lo) ? lo : x.
 __m128 select(__m128 mask, __m128 if_true, __m128 if_false) {
   return _mm_or_ps(_mm_and_ps(mask, if_true), _mm_andnot_ps(mask, if_false));
 }
 }  // namespace
 
-// add_neighbour_force for candidates[0, count) in order, four at a time with SSE2 (exp4 gives
-// each lane what exp1 gives). A group with a neighbour on the very same spot goes the scalar
-// way, which separates the pair by id.
-void SocialForces::add_neighbour_forces(const AgentTerms& a, size_t k, const uint32_t* candidates,
-                                        uint32_t count, glm::vec2* acc) const {
+// Lane l sums the forces of candidates l, l + 4, l + 8, ... of an agent, in that order; the lanes
+// are added up once at the end in a fixed order, so the result depends only on the candidate
+// list (cell order), never on the thread count.
+struct SocialForces::NeighbourSums {
+  __m128 x = _mm_setzero_ps(), z = _mm_setzero_ps();
+  glm::vec2 total() const {
+    alignas(16) float sx[4], sz[4];
+    _mm_store_ps(sx, x);
+    _mm_store_ps(sz, z);
+    return {(sx[0] + sx[1]) + (sx[2] + sx[3]), (sz[0] + sz[1]) + (sz[2] + sz[3])};
+  }
+};
+
+// The forces of the neighbours (sorted indices) candidates[0, count) on an agent, four at a time
+// with SSE2, added to *sums.
+void SocialForces::add_neighbour_forces(const AgentTerms& a, const uint32_t* candidates,
+                                        uint32_t count, NeighbourSums* sums) const {
   const SocialForceParams& p = params_;
   const __m128 px = _mm_set1_ps(a.position.x), pz = _mm_set1_ps(a.position.y);
   const __m128 vx = _mm_set1_ps(a.velocity.x), vz = _mm_set1_ps(a.velocity.y);
   const __m128 fx = _mm_set1_ps(a.facing.x), fz = _mm_set1_ps(a.facing.y);
+  const __m128 right_x = _mm_set1_ps(a.right.x), right_z = _mm_set1_ps(a.right.y);
   const __m128 ri = _mm_set1_ps(a.radius);
   const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f);
   const __m128 lambda = _mm_set1_ps(p.field_of_view_weight);
   const __m128 lambda_rest = _mm_set1_ps(1.0f - p.field_of_view_weight);
   const __m128 anticipation = _mm_set1_ps(p.anticipation_time_s);
   const __m128 inv_b = _mm_set1_ps(1.0f / p.agent_range_m);
-  const float strength = p.agent_strength_m_s2;
-  const float side_step = p.side_step;
-  const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
+  const __m128 strength = _mm_set1_ps(p.agent_strength_m_s2);
+  const __m128 side_step = _mm_set1_ps(p.side_step);
+  const __m128 stiffness = _mm_set1_ps(p.contact_forces ? p.body_stiffness_s2 : 0.0f);
+  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
   for (uint32_t g = 0; g < count; g += 4) {
     const uint32_t lanes = std::min(count - g, 4u);
-    // Unused lanes repeat the group's first neighbour. Each record starts with position and
-    // velocity: four loads and a transpose give them lane by lane.
+    const __m128 used = _mm_castsi128_ps(_mm_cmplt_epi32(lane, _mm_set1_epi32(int(lanes))));
+    // Unused lanes repeat the group's first neighbour (and add nothing). Each record starts with
+    // position and velocity: four loads and a transpose give them lane by lane.
     const Body& o0 = sorted_[candidates[g]];
     const Body& o1 = sorted_[candidates[g + (lanes > 1 ? 1 : 0)]];
     const Body& o2 = sorted_[candidates[g + (lanes > 2 ? 2 : 0)]];
@@ -315,53 +282,63 @@ void SocialForces::add_neighbour_forces(const AgentTerms& a, size_t k, const uin
     const __m128 orad = _mm_setr_ps(o0.radius, o1.radius, o2.radius, o3.radius);
     const __m128 dx = _mm_sub_ps(px, ox), dz = _mm_sub_ps(pz, oz);
     const __m128 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dz, dz));
-    if (_mm_movemask_ps(_mm_cmple_ps(d2, _mm_set1_ps(1e-12f))) & ((1 << lanes) - 1)) {
-      for (uint32_t l = 0; l < lanes; ++l) add_neighbour_force(a, k, candidates[g + l], acc);
-      continue;
+    __m128 dist = _mm_sqrt_ps(d2);
+    const __m128 inv_dist = _mm_div_ps(one, dist);
+    __m128 nx = _mm_mul_ps(dx, inv_dist), nz = _mm_mul_ps(dz, inv_dist);
+    const __m128 same_spot = _mm_and_ps(used, _mm_cmple_ps(d2, _mm_set1_ps(1e-12f)));
+    if (_mm_movemask_ps(same_spot)) {  // rare: separate the pair by id, so it pushes apart
+      alignas(16) float sign[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+      const auto order = impl_->grid.order();
+      for (uint32_t l = 0; l < lanes; ++l) {
+        if (a.id < id_[order[candidates[g + l]]]) sign[l] = -1.0f;
+      }
+      nx = select(same_spot, _mm_load_ps(sign), nx);
+      nz = select(same_spot, zero, nz);
+      dist = select(same_spot, zero, dist);
     }
-    const __m128 dist = _mm_sqrt_ps(d2);
-    const __m128 nx = _mm_div_ps(dx, dist), nz = _mm_div_ps(dz, dist);
     const __m128 radii = _mm_add_ps(ri, orad);
     const __m128 overlap = _mm_sub_ps(radii, dist);
-    const __m128 cos_phi =  // negated by the sign bit, as unary minus does
+    const __m128 cos_phi =  // 1: the other is straight ahead
         _mm_xor_ps(_mm_set1_ps(-0.0f), _mm_add_ps(_mm_mul_ps(nx, fx), _mm_mul_ps(nz, fz)));
-    const __m128 w = _mm_add_ps(lambda, _mm_mul_ps(_mm_mul_ps(lambda_rest, half),
-                                                   _mm_add_ps(one, cos_phi)));
+    const __m128 w =
+        _mm_add_ps(lambda, _mm_mul_ps(_mm_mul_ps(lambda_rest, half), _mm_add_ps(one, cos_phi)));
+    // Elliptical specification II (Johansson, Helbing & Shukla 2007): the distance is replaced by
+    // the semi-minor axis b of an ellipse through p_i with foci at p_j and at p_j moved by the
+    // relative velocity over the anticipation time, so agents on a collision course repel early
+    // and sideways, while agents walking alongside barely interact.
     const __m128 yx = _mm_mul_ps(_mm_sub_ps(ovx, vx), anticipation);
     const __m128 yz = _mm_mul_ps(_mm_sub_ps(ovz, vz), anticipation);
     const __m128 dyx = _mm_sub_ps(dx, yx), dyz = _mm_sub_ps(dz, yz);
     const __m128 dy_len = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dyx, dyx), _mm_mul_ps(dyz, dyz)));
     const __m128 sum = _mm_add_ps(dist, dy_len);
     const __m128 yy = _mm_add_ps(_mm_mul_ps(yx, yx), _mm_mul_ps(yz, yz));
-    const __m128 b = _mm_mul_ps(
-        half, _mm_sqrt_ps(max_as_std(_mm_sub_ps(_mm_mul_ps(sum, sum), yy), zero)));
-    const __m128 floor_b =
-        _mm_add_ps(_mm_mul_ps(_mm_set1_ps(0.1f), sum), _mm_set1_ps(1e-6f));
-    const __m128 stretch =
-        _mm_div_ps(sum, _mm_mul_ps(_mm_set1_ps(2.0f), max_as_std(b, floor_b)));
+    const __m128 b =
+        _mm_mul_ps(half, _mm_sqrt_ps(_mm_max_ps(zero, _mm_sub_ps(_mm_mul_ps(sum, sum), yy))));
+    // The potential's gradient grows as sum / 2b; capping b keeps it finite when the other is
+    // predicted to pass right through p_i.
+    const __m128 floor_b = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(0.1f), sum), _mm_set1_ps(1e-6f));
+    const __m128 stretch = _mm_div_ps(sum, _mm_mul_ps(_mm_set1_ps(2.0f), _mm_max_ps(floor_b, b)));
     const __m128 has_dy = _mm_cmpgt_ps(dy_len, _mm_set1_ps(1e-6f));
-    const __m128 ux = select(has_dy, _mm_div_ps(dyx, dy_len), nx);
-    const __m128 uz = select(has_dy, _mm_div_ps(dyz, dy_len), nz);
-    const __m128 dirx = _mm_mul_ps(half, _mm_add_ps(nx, ux));
-    const __m128 dirz = _mm_mul_ps(half, _mm_add_ps(nz, uz));
-    const __m128 e = exp4(_mm_mul_ps(_mm_sub_ps(radii, b), inv_b));
-    const __m128 repulsion =
-        _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(strength), e), w), stretch);
-    alignas(16) float rx[4], rz[4], side[4], cosv[4], contact[4], ox_n[4], oz_n[4];
-    _mm_store_ps(rx, _mm_mul_ps(repulsion, dirx));
-    _mm_store_ps(rz, _mm_mul_ps(repulsion, dirz));
-    _mm_store_ps(side, _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(side_step), repulsion), cos_phi));
-    _mm_store_ps(cosv, cos_phi);
-    _mm_store_ps(contact, _mm_mul_ps(_mm_set1_ps(stiffness), overlap));
-    alignas(16) float ov[4];
-    _mm_store_ps(ov, overlap);
-    _mm_store_ps(ox_n, nx);
-    _mm_store_ps(oz_n, nz);
-    for (uint32_t l = 0; l < lanes; ++l) {
-      *acc += glm::vec2(rx[l], rz[l]);
-      if (cosv[l] > 0.0f) *acc += side[l] * a.right;
-      if (ov[l] > 0.0f) *acc += contact[l] * glm::vec2(ox_n[l], oz_n[l]);
-    }
+    const __m128 inv_dy = _mm_div_ps(one, dy_len);
+    const __m128 dirx =
+        _mm_mul_ps(half, _mm_add_ps(nx, select(has_dy, _mm_mul_ps(dyx, inv_dy), nx)));
+    const __m128 dirz =
+        _mm_mul_ps(half, _mm_add_ps(nz, select(has_dy, _mm_mul_ps(dyz, inv_dy), nz)));
+    const __m128 repulsion = _mm_mul_ps(
+        _mm_mul_ps(_mm_mul_ps(strength, exp4(_mm_mul_ps(_mm_sub_ps(radii, b), inv_b))), w),
+        stretch);
+    // Side-step to the right for what is ahead; body contact along n where bodies overlap.
+    const __m128 side = _mm_and_ps(_mm_cmpgt_ps(cos_phi, zero),
+                                   _mm_mul_ps(_mm_mul_ps(side_step, repulsion), cos_phi));
+    const __m128 contact = _mm_and_ps(_mm_cmpgt_ps(overlap, zero), _mm_mul_ps(stiffness, overlap));
+    const __m128 force_x =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(repulsion, dirx), _mm_mul_ps(side, right_x)),
+                   _mm_mul_ps(contact, nx));
+    const __m128 force_z =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(repulsion, dirz), _mm_mul_ps(side, right_z)),
+                   _mm_mul_ps(contact, nz));
+    sums->x = _mm_add_ps(sums->x, _mm_and_ps(used, force_x));
+    sums->z = _mm_add_ps(sums->z, _mm_and_ps(used, force_z));
   }
 }
 
@@ -390,12 +367,13 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     const float speed = glm::length(vel);
     const glm::vec2 facing = speed > 0.1f ? vel / speed : dir;
     const glm::vec2 right(-facing.y, facing.x);
-    const AgentTerms terms{pos, vel, facing, right, r_i};
+    const AgentTerms terms{pos, vel, facing, right, r_i, id_[i]};
     const auto [cx, cz] = grid.cell_of(pos);
     // The neighbours within the cutoff, in cell order, go through a small buffer (written without
     // a branch) and their forces are computed four at a time; the sums stay in neighbour order.
     uint32_t candidates[kCandidates];
     uint32_t count = 0;
+    NeighbourSums sums;
     for (int z = cz - 1; z <= cz + 1; ++z) {
       const auto [m0, m1] = grid.row_range(z, cx - 1, cx + 1);
       for (uint32_t m = m0; m < m1; ++m) {
@@ -404,12 +382,13 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
         candidates[count] = m;
         count += static_cast<uint32_t>(d2 < cutoff2) & static_cast<uint32_t>(m != k);
         if (count == kCandidates) {
-          add_neighbour_forces(terms, k, candidates, count, &acc);
+          add_neighbour_forces(terms, candidates, count, &sums);
           count = 0;
         }
       }
     }
-    add_neighbour_forces(terms, k, candidates, count, &acc);
+    add_neighbour_forces(terms, candidates, count, &sums);
+    acc += sums.total();
     for (const uint32_t wi : impl_->walls.near(pos)) {
       const WallSegment& wall = impl_->walls.walls()[wi];
       const glm::vec2 d = pos - closest_point_on_segment(pos, wall.a, wall.b);

@@ -97,10 +97,11 @@ class SocialForces final : public CrowdSource {
   struct AgentTerms {
     glm::vec2 position, velocity, facing, right;
     float radius;
+    uint32_t id;  // separates a pair on the very same spot
   };
-  void add_neighbour_force(const AgentTerms& a, size_t k, uint32_t m, glm::vec2* acc) const;
-  void add_neighbour_forces(const AgentTerms& a, size_t k, const uint32_t* candidates,
-                            uint32_t count, glm::vec2* acc) const;
+  struct NeighbourSums;  // four lane sums (SSE registers), defined in the .cc
+  void add_neighbour_forces(const AgentTerms& a, const uint32_t* candidates, uint32_t count,
+                            NeighbourSums* sums) const;
   void prepare(size_t begin, size_t end);
   void compute_velocities(size_t begin, size_t end, float dt_s);
   void commit(size_t begin, size_t end, float dt_s);
