@@ -175,6 +175,8 @@ Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scena
   s.new_velocity_.resize(n);
   s.body_.resize(n);
   s.sorted_.resize(n);
+  s.sorted_x_.assign(n + 3, 0.0f);  // a row's last group of four may read three past its end
+  s.sorted_z_.assign(n + 3, 0.0f);
   return sim;
 }
 
@@ -200,7 +202,11 @@ Status SocialForces::step(float dt_s) {
   const auto order = impl_->grid.order();
   // Gather in cell order, so that neighbours are contiguous: one record read per agent.
   for_agents([&](size_t b, size_t e) {
-    for (size_t k = b; k < e; ++k) sorted_[k] = body_[order[k]];
+    for (size_t k = b; k < e; ++k) {
+      sorted_[k] = body_[order[k]];
+      sorted_x_[k] = sorted_[k].position.x;
+      sorted_z_[k] = sorted_[k].position.y;
+    }
   });
   impl_->non_finite.store(false, std::memory_order_relaxed);
   for_agents([&](size_t b, size_t e) { compute_velocities(b, e, dt_s); });
@@ -233,6 +239,23 @@ __m128 select(__m128 mask, __m128 if_true, __m128 if_false) {
   return _mm_or_ps(_mm_and_ps(mask, if_true), _mm_andnot_ps(mask, if_false));
 }
 }  // namespace
+
+// For each 4-bit mask of candidates kept, the lanes kept packed to the front, and their count.
+struct alignas(16) Pack {
+  int32_t lanes[4];
+  uint32_t count;
+};
+constexpr Pack make_pack(uint32_t bits) {
+  Pack pack{{0, 0, 0, 0}, 0};
+  for (int32_t l = 0; l < 4; ++l) {
+    if (bits & (1u << l)) pack.lanes[pack.count++] = l;
+  }
+  return pack;
+}
+constexpr Pack kPack[16] = {make_pack(0),  make_pack(1),  make_pack(2),  make_pack(3),
+                            make_pack(4),  make_pack(5),  make_pack(6),  make_pack(7),
+                            make_pack(8),  make_pack(9),  make_pack(10), make_pack(11),
+                            make_pack(12), make_pack(13), make_pack(14), make_pack(15)};
 
 // Lane l sums the forces of candidates l, l + 4, l + 8, ... of an agent, in that order; the lanes
 // are added up once at the end in a fixed order, so the result depends only on the candidate
@@ -349,7 +372,9 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
   const SocialForceParams& p = params_;
   const float inv_tau = 1.0f / p.relaxation_time_s;
   const float inv_bw = 1.0f / p.wall_range_m;
-  const float cutoff2 = p.neighbour_radius_m * p.neighbour_radius_m;
+  const __m128 cutoff2 = _mm_set1_ps(p.neighbour_radius_m * p.neighbour_radius_m);
+  int cell_x = -1, cell_z = -1;
+  std::pair<uint32_t, uint32_t> rows[3];
   const float wall_cutoff2 = p.wall_radius_m * p.wall_radius_m;
   const float stiffness = p.contact_forces ? p.body_stiffness_s2 : 0.0f;
   for (size_t k = begin; k < end; ++k) {
@@ -368,20 +393,33 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     const glm::vec2 facing = speed > 0.1f ? vel / speed : dir;
     const glm::vec2 right(-facing.y, facing.x);
     const AgentTerms terms{pos, vel, facing, right, r_i, id_[i]};
+    // The agents of the 3 x 3 cells around, three contiguous row ranges, shared by the agents of
+    // one cell (they are consecutive in k).
     const auto [cx, cz] = grid.cell_of(pos);
-    // The neighbours within the cutoff, in cell order, go through a small buffer (written without
-    // a branch) and their forces are computed four at a time; the sums stay in neighbour order.
+    if (cx != cell_x || cz != cell_z) {
+      cell_x = cx, cell_z = cz;
+      for (int r = 0; r < 3; ++r) rows[r] = grid.row_range(cz - 1 + r, cx - 1, cx + 1);
+    }
+    // Four candidates at a time: those within the cutoff (not the agent itself) are appended to a
+    // small buffer in cell order, and their forces are computed four at a time when it fills.
     uint32_t candidates[kCandidates];
     uint32_t count = 0;
     NeighbourSums sums;
-    for (int z = cz - 1; z <= cz + 1; ++z) {
-      const auto [m0, m1] = grid.row_range(z, cx - 1, cx + 1);
-      for (uint32_t m = m0; m < m1; ++m) {
-        const glm::vec2 d = pos - sorted_[m].position;
-        const float d2 = glm::dot(d, d);
-        candidates[count] = m;
-        count += static_cast<uint32_t>(d2 < cutoff2) & static_cast<uint32_t>(m != k);
-        if (count == kCandidates) {
+    const __m128 px = _mm_set1_ps(pos.x), pz = _mm_set1_ps(pos.y);
+    for (const auto& [m0, m1] : rows) {
+      for (uint32_t m = m0; m < m1; m += 4) {
+        const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(&sorted_x_[m]));
+        const __m128 dz = _mm_sub_ps(pz, _mm_loadu_ps(&sorted_z_[m]));
+        const __m128 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dz, dz));
+        uint32_t bits = static_cast<uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(d2, cutoff2)));
+        if (m1 - m < 4) bits &= (1u << (m1 - m)) - 1;  // past the row (the arrays are padded)
+        if (k - m < 4) bits &= ~(1u << (k - m));       // the agent itself
+        _mm_storeu_si128(
+            reinterpret_cast<__m128i*>(candidates + count),
+            _mm_add_epi32(_mm_set1_epi32(static_cast<int>(m)),
+                          _mm_load_si128(reinterpret_cast<const __m128i*>(kPack[bits].lanes))));
+        count += kPack[bits].count;
+        if (count > kCandidates - 4) {
           add_neighbour_forces(terms, candidates, count, &sums);
           count = 0;
         }

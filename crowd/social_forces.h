@@ -136,6 +136,7 @@ class SocialForces final : public CrowdSource {
     float radius, desired_speed;
   };
   std::vector<Body> body_, sorted_;
+  std::vector<float> sorted_x_, sorted_z_;  // sorted_'s positions, for the neighbour scan
   std::vector<glm::vec2> new_velocity_;
 };
 

@@ -75,17 +75,6 @@ Result<UniformGrid> UniformGrid::create(glm::vec2 min, glm::vec2 max, float cell
   return g;
 }
 
-std::pair<int, int> UniformGrid::cell_of(glm::vec2 p) const {
-  // Written with comparisons so that NaN lands in cell 0 instead of an undefined float-to-int cast.
-  const float fx = (p.x - min_.x) * inv_cell_;
-  const float fz = (p.y - min_.y) * inv_cell_;
-  const int cx =
-      fx >= 0.0f ? (fx < static_cast<float>(num_x_) ? static_cast<int>(fx) : num_x_ - 1) : 0;
-  const int cz =
-      fz >= 0.0f ? (fz < static_cast<float>(num_z_) ? static_cast<int>(fz) : num_z_ - 1) : 0;
-  return {cx, cz};
-}
-
 void UniformGrid::build(std::span<const glm::vec2> points) {
   assert(points.size() <= order_.size());
   num_points_ = points.size();
@@ -100,15 +89,6 @@ void UniformGrid::build(std::span<const glm::vec2> points) {
   std::copy(cell_start_.begin(), cell_start_.end() - 1, cursor_.begin());
   for (size_t i = 0; i < points.size(); ++i)
     order_[cursor_[point_cell_[i]]++] = static_cast<uint32_t>(i);
-}
-
-std::pair<uint32_t, uint32_t> UniformGrid::row_range(int z, int x0, int x1) const {
-  if (z < 0 || z >= num_z_) return {0, 0};
-  x0 = std::max(x0, 0);
-  x1 = std::min(x1, num_x_ - 1);
-  if (x0 > x1) return {0, 0};
-  const size_t row = static_cast<size_t>(z) * static_cast<size_t>(num_x_);
-  return {cell_start_[row + x0], cell_start_[row + x1 + 1]};
 }
 
 WallGrid::WallGrid(std::span<const WallSegment> walls, float cell_size_m, float reach_m)
@@ -156,20 +136,6 @@ WallGrid::WallGrid(std::span<const WallSegment> walls, float cell_size_m, float 
     cell_start_[c + 1] = cell_start_[c] + static_cast<uint32_t>(lists[c].size());
     items_.insert(items_.end(), lists[c].begin(), lists[c].end());
   }
-}
-
-std::span<const uint32_t> WallGrid::near(glm::vec2 p) const {
-  if (walls_.empty()) return {};
-  const float fx = (p.x - min_.x) * inv_cell_;
-  const float fz = (p.y - min_.y) * inv_cell_;
-  // Outside the grid (or NaN) means farther than reach from every wall: the grid is the walls'
-  // bounding box grown by reach.
-  if (!(fx >= 0.0f && fz >= 0.0f && fx < static_cast<float>(num_x_) &&
-        fz < static_cast<float>(num_z_))) {
-    return {};
-  }
-  const size_t c = static_cast<size_t>(fz) * num_x_ + static_cast<size_t>(fx);
-  return {items_.data() + cell_start_[c], items_.data() + cell_start_[c + 1]};
 }
 
 // Where an agent moving from `from` toward `to` may end up: a step that would cross a wall slides

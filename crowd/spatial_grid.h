@@ -3,6 +3,7 @@
 // sort, so a neighbour search is linear in the number of agents; WallGrid lists, once, the static
 // wall segments near each cell. Plus the segment geometry both need.
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -84,5 +85,41 @@ class WallGrid {
   std::vector<uint32_t> cell_start_;
   std::vector<uint32_t> items_;
 };
+
+// Defined here so that the per-agent look-ups of the simulator inline.
+
+inline std::pair<int, int> UniformGrid::cell_of(glm::vec2 p) const {
+  // Written with comparisons so that NaN lands in cell 0 instead of an undefined float-to-int cast.
+  const float fx = (p.x - min_.x) * inv_cell_;
+  const float fz = (p.y - min_.y) * inv_cell_;
+  const int cx =
+      fx >= 0.0f ? (fx < static_cast<float>(num_x_) ? static_cast<int>(fx) : num_x_ - 1) : 0;
+  const int cz =
+      fz >= 0.0f ? (fz < static_cast<float>(num_z_) ? static_cast<int>(fz) : num_z_ - 1) : 0;
+  return {cx, cz};
+}
+
+inline std::pair<uint32_t, uint32_t> UniformGrid::row_range(int z, int x0, int x1) const {
+  if (z < 0 || z >= num_z_) return {0, 0};
+  x0 = std::max(x0, 0);
+  x1 = std::min(x1, num_x_ - 1);
+  if (x0 > x1) return {0, 0};
+  const size_t row = static_cast<size_t>(z) * static_cast<size_t>(num_x_);
+  return {cell_start_[row + x0], cell_start_[row + x1 + 1]};
+}
+
+inline std::span<const uint32_t> WallGrid::near(glm::vec2 p) const {
+  if (walls_.empty()) return {};
+  const float fx = (p.x - min_.x) * inv_cell_;
+  const float fz = (p.y - min_.y) * inv_cell_;
+  // Outside the grid (or NaN) means farther than reach from every wall: the grid is the walls'
+  // bounding box grown by reach.
+  if (!(fx >= 0.0f && fz >= 0.0f && fx < static_cast<float>(num_x_) &&
+        fz < static_cast<float>(num_z_))) {
+    return {};
+  }
+  const size_t c = static_cast<size_t>(fz) * num_x_ + static_cast<size_t>(fx);
+  return {items_.data() + cell_start_[c], items_.data() + cell_start_[c + 1]};
+}
 
 }  // namespace gk
