@@ -259,36 +259,44 @@ constexpr Pack kPack[16] = {make_pack(0),  make_pack(1),  make_pack(2),  make_pa
 
 // Lane l sums the forces of candidates l, l + 4, l + 8, ... of an agent, in that order; the lanes
 // are added up once at the end in a fixed order, so the result depends only on the candidate
-// list (cell order), never on the thread count.
-struct SocialForces::NeighbourSums {
-  __m128 x = _mm_setzero_ps(), z = _mm_setzero_ps();
+// list (cell order), never on the thread count. The parameters are broadcast once per pass.
+struct SocialForces::ForceLanes {
+  explicit ForceLanes(const SocialForceParams& p)
+      : lambda(_mm_set1_ps(p.field_of_view_weight)),
+        lambda_rest_half(_mm_set1_ps((1.0f - p.field_of_view_weight) * 0.5f)),
+        anticipation(_mm_set1_ps(p.anticipation_time_s)),
+        inv_b(_mm_set1_ps(1.0f / p.agent_range_m)),
+        strength(_mm_set1_ps(p.agent_strength_m_s2)),
+        side_step(_mm_set1_ps(p.side_step)),
+        stiffness(_mm_set1_ps(p.contact_forces ? p.body_stiffness_s2 : 0.0f)) {}
+  void set_agent(glm::vec2 position, glm::vec2 velocity, glm::vec2 facing, float radius,
+                 uint32_t agent_id) {
+    px = _mm_set1_ps(position.x), pz = _mm_set1_ps(position.y);
+    vx = _mm_set1_ps(velocity.x), vz = _mm_set1_ps(velocity.y);
+    fx = _mm_set1_ps(facing.x), fz = _mm_set1_ps(facing.y);
+    ri = _mm_set1_ps(radius);
+    id = agent_id;
+    sum_x = sum_z = _mm_setzero_ps();
+  }
   glm::vec2 total() const {
     alignas(16) float sx[4], sz[4];
-    _mm_store_ps(sx, x);
-    _mm_store_ps(sz, z);
+    _mm_store_ps(sx, sum_x);
+    _mm_store_ps(sz, sum_z);
     return {(sx[0] + sx[1]) + (sx[2] + sx[3]), (sz[0] + sz[1]) + (sz[2] + sz[3])};
   }
+  __m128 lambda, lambda_rest_half, anticipation, inv_b, strength, side_step, stiffness;
+  __m128 px, pz, vx, vz, fx, fz, ri;  // the agent; its right is (-fz, fx)
+  uint32_t id = 0;
+  __m128 sum_x, sum_z;
 };
 
-// The forces of the neighbours (sorted indices) candidates[0, count) on an agent, four at a time
-// with SSE2, added to *sums.
-void SocialForces::add_neighbour_forces(const AgentTerms& a, const uint32_t* candidates,
-                                        uint32_t count, NeighbourSums* sums) const {
-  const SocialForceParams& p = params_;
-  const __m128 px = _mm_set1_ps(a.position.x), pz = _mm_set1_ps(a.position.y);
-  const __m128 vx = _mm_set1_ps(a.velocity.x), vz = _mm_set1_ps(a.velocity.y);
-  const __m128 fx = _mm_set1_ps(a.facing.x), fz = _mm_set1_ps(a.facing.y);
-  const __m128 right_x = _mm_set1_ps(a.right.x), right_z = _mm_set1_ps(a.right.y);
-  const __m128 ri = _mm_set1_ps(a.radius);
+// The forces of the neighbours (sorted indices) candidates[0, count) on the agent of *f, four at
+// a time with SSE2, added to its lane sums.
+void SocialForces::add_neighbour_forces(const uint32_t* candidates, uint32_t count,
+                                        ForceLanes* f) const {
   const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f);
-  const __m128 lambda = _mm_set1_ps(p.field_of_view_weight);
-  const __m128 lambda_rest = _mm_set1_ps(1.0f - p.field_of_view_weight);
-  const __m128 anticipation = _mm_set1_ps(p.anticipation_time_s);
-  const __m128 inv_b = _mm_set1_ps(1.0f / p.agent_range_m);
-  const __m128 strength = _mm_set1_ps(p.agent_strength_m_s2);
-  const __m128 side_step = _mm_set1_ps(p.side_step);
-  const __m128 stiffness = _mm_set1_ps(p.contact_forces ? p.body_stiffness_s2 : 0.0f);
   const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+  __m128 sum_x = f->sum_x, sum_z = f->sum_z;
   for (uint32_t g = 0; g < count; g += 4) {
     const uint32_t lanes = std::min(count - g, 4u);
     const __m128 used = _mm_castsi128_ps(_mm_cmplt_epi32(lane, _mm_set1_epi32(int(lanes))));
@@ -303,7 +311,7 @@ void SocialForces::add_neighbour_forces(const AgentTerms& a, const uint32_t* can
     __m128 ovx = _mm_loadu_ps(&o2.position.x), ovz = _mm_loadu_ps(&o3.position.x);
     _MM_TRANSPOSE4_PS(ox, oz, ovx, ovz);
     const __m128 orad = _mm_setr_ps(o0.radius, o1.radius, o2.radius, o3.radius);
-    const __m128 dx = _mm_sub_ps(px, ox), dz = _mm_sub_ps(pz, oz);
+    const __m128 dx = _mm_sub_ps(f->px, ox), dz = _mm_sub_ps(f->pz, oz);
     const __m128 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dz, dz));
     __m128 dist = _mm_sqrt_ps(d2);
     const __m128 inv_dist = _mm_div_ps(one, dist);
@@ -313,24 +321,24 @@ void SocialForces::add_neighbour_forces(const AgentTerms& a, const uint32_t* can
       alignas(16) float sign[4] = {1.0f, 1.0f, 1.0f, 1.0f};
       const auto order = impl_->grid.order();
       for (uint32_t l = 0; l < lanes; ++l) {
-        if (a.id < id_[order[candidates[g + l]]]) sign[l] = -1.0f;
+        if (f->id < id_[order[candidates[g + l]]]) sign[l] = -1.0f;
       }
       nx = select(same_spot, _mm_load_ps(sign), nx);
       nz = select(same_spot, zero, nz);
       dist = select(same_spot, zero, dist);
     }
-    const __m128 radii = _mm_add_ps(ri, orad);
+    const __m128 radii = _mm_add_ps(f->ri, orad);
     const __m128 overlap = _mm_sub_ps(radii, dist);
     const __m128 cos_phi =  // 1: the other is straight ahead
-        _mm_xor_ps(_mm_set1_ps(-0.0f), _mm_add_ps(_mm_mul_ps(nx, fx), _mm_mul_ps(nz, fz)));
+        _mm_xor_ps(_mm_set1_ps(-0.0f), _mm_add_ps(_mm_mul_ps(nx, f->fx), _mm_mul_ps(nz, f->fz)));
     const __m128 w =
-        _mm_add_ps(lambda, _mm_mul_ps(_mm_mul_ps(lambda_rest, half), _mm_add_ps(one, cos_phi)));
+        _mm_add_ps(f->lambda, _mm_mul_ps(f->lambda_rest_half, _mm_add_ps(one, cos_phi)));
     // Elliptical specification II (Johansson, Helbing & Shukla 2007): the distance is replaced by
     // the semi-minor axis b of an ellipse through p_i with foci at p_j and at p_j moved by the
     // relative velocity over the anticipation time, so agents on a collision course repel early
     // and sideways, while agents walking alongside barely interact.
-    const __m128 yx = _mm_mul_ps(_mm_sub_ps(ovx, vx), anticipation);
-    const __m128 yz = _mm_mul_ps(_mm_sub_ps(ovz, vz), anticipation);
+    const __m128 yx = _mm_mul_ps(_mm_sub_ps(ovx, f->vx), f->anticipation);
+    const __m128 yz = _mm_mul_ps(_mm_sub_ps(ovz, f->vz), f->anticipation);
     const __m128 dyx = _mm_sub_ps(dx, yx), dyz = _mm_sub_ps(dz, yz);
     const __m128 dy_len = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dyx, dyx), _mm_mul_ps(dyz, dyz)));
     const __m128 sum = _mm_add_ps(dist, dy_len);
@@ -348,21 +356,23 @@ void SocialForces::add_neighbour_forces(const AgentTerms& a, const uint32_t* can
     const __m128 dirz =
         _mm_mul_ps(half, _mm_add_ps(nz, select(has_dy, _mm_mul_ps(dyz, inv_dy), nz)));
     const __m128 repulsion = _mm_mul_ps(
-        _mm_mul_ps(_mm_mul_ps(strength, exp4(_mm_mul_ps(_mm_sub_ps(radii, b), inv_b))), w),
+        _mm_mul_ps(_mm_mul_ps(f->strength, exp4(_mm_mul_ps(_mm_sub_ps(radii, b), f->inv_b))), w),
         stretch);
-    // Side-step to the right for what is ahead; body contact along n where bodies overlap.
+    // Side-step to the right, (-fz, fx), for what is ahead; body contact along n where bodies
+    // overlap.
     const __m128 side = _mm_and_ps(_mm_cmpgt_ps(cos_phi, zero),
-                                   _mm_mul_ps(_mm_mul_ps(side_step, repulsion), cos_phi));
-    const __m128 contact = _mm_and_ps(_mm_cmpgt_ps(overlap, zero), _mm_mul_ps(stiffness, overlap));
-    const __m128 force_x =
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(repulsion, dirx), _mm_mul_ps(side, right_x)),
-                   _mm_mul_ps(contact, nx));
-    const __m128 force_z =
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(repulsion, dirz), _mm_mul_ps(side, right_z)),
-                   _mm_mul_ps(contact, nz));
-    sums->x = _mm_add_ps(sums->x, _mm_and_ps(used, force_x));
-    sums->z = _mm_add_ps(sums->z, _mm_and_ps(used, force_z));
+                                   _mm_mul_ps(_mm_mul_ps(f->side_step, repulsion), cos_phi));
+    const __m128 contact =
+        _mm_and_ps(_mm_cmpgt_ps(overlap, zero), _mm_mul_ps(f->stiffness, overlap));
+    const __m128 force_x = _mm_add_ps(
+        _mm_sub_ps(_mm_mul_ps(repulsion, dirx), _mm_mul_ps(side, f->fz)), _mm_mul_ps(contact, nx));
+    const __m128 force_z = _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(repulsion, dirz), _mm_mul_ps(side, f->fx)), _mm_mul_ps(contact, nz));
+    sum_x = _mm_add_ps(sum_x, _mm_and_ps(used, force_x));
+    sum_z = _mm_add_ps(sum_z, _mm_and_ps(used, force_z));
   }
+  f->sum_x = sum_x;
+  f->sum_z = sum_z;
 }
 
 // Pass 1: new velocity of the agents at sorted positions [begin, end), from the frozen state.
@@ -373,6 +383,7 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
   const float inv_tau = 1.0f / p.relaxation_time_s;
   const float inv_bw = 1.0f / p.wall_range_m;
   const __m128 cutoff2 = _mm_set1_ps(p.neighbour_radius_m * p.neighbour_radius_m);
+  ForceLanes forces(p);
   int cell_x = -1, cell_z = -1;
   std::pair<uint32_t, uint32_t> rows[3];
   const float wall_cutoff2 = p.wall_radius_m * p.wall_radius_m;
@@ -391,8 +402,7 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     // Facing for the field of view: the velocity, or the desired direction when (nearly) still.
     const float speed = glm::length(vel);
     const glm::vec2 facing = speed > 0.1f ? vel / speed : dir;
-    const glm::vec2 right(-facing.y, facing.x);
-    const AgentTerms terms{pos, vel, facing, right, r_i, id_[i]};
+    forces.set_agent(pos, vel, facing, r_i, id_[i]);
     // The agents of the 3 x 3 cells around, three contiguous row ranges, shared by the agents of
     // one cell (they are consecutive in k).
     const auto [cx, cz] = grid.cell_of(pos);
@@ -404,7 +414,6 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     // small buffer in cell order, and their forces are computed four at a time when it fills.
     uint32_t candidates[kCandidates];
     uint32_t count = 0;
-    NeighbourSums sums;
     const __m128 px = _mm_set1_ps(pos.x), pz = _mm_set1_ps(pos.y);
     for (const auto& [m0, m1] : rows) {
       for (uint32_t m = m0; m < m1; m += 4) {
@@ -420,13 +429,13 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
                           _mm_load_si128(reinterpret_cast<const __m128i*>(kPack[bits].lanes))));
         count += kPack[bits].count;
         if (count > kCandidates - 4) {
-          add_neighbour_forces(terms, candidates, count, &sums);
+          add_neighbour_forces(candidates, count, &forces);
           count = 0;
         }
       }
     }
-    add_neighbour_forces(terms, candidates, count, &sums);
-    acc += sums.total();
+    add_neighbour_forces(candidates, count, &forces);
+    acc += forces.total();
     for (const uint32_t wi : impl_->walls.near(pos)) {
       const WallSegment& wall = impl_->walls.walls()[wi];
       const glm::vec2 d = pos - closest_point_on_segment(pos, wall.a, wall.b);

@@ -93,15 +93,10 @@ class SocialForces final : public CrowdSource {
  private:
   struct Impl;
   SocialForces(const SocialForceParams& params, size_t capacity);
-  // What one agent's neighbour forces need of it.
-  struct AgentTerms {
-    glm::vec2 position, velocity, facing, right;
-    float radius;
-    uint32_t id;  // separates a pair on the very same spot
-  };
-  struct NeighbourSums;  // four lane sums (SSE registers), defined in the .cc
-  void add_neighbour_forces(const AgentTerms& a, const uint32_t* candidates, uint32_t count,
-                            NeighbourSums* sums) const;
+  // The force parameters and one agent's terms broadcast to SSE lanes, with the agent's four
+  // lane sums; defined in the .cc, so that this header carries no SSE types.
+  struct ForceLanes;
+  void add_neighbour_forces(const uint32_t* candidates, uint32_t count, ForceLanes* f) const;
   void prepare(size_t begin, size_t end);
   void compute_velocities(size_t begin, size_t end, float dt_s);
   void commit(size_t begin, size_t end, float dt_s);
