@@ -15,6 +15,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "crowd/simd_atan2.h"
 #include "crowd/simd_exp.h"
 #include "crowd/spatial_grid.h"
 
@@ -33,8 +34,9 @@ float wrap_angle(float a) {
   if (std::abs(a) <= kPi) return a;
   return std::remainder(a, 2.0f * kPi);
 }
-// theta convention of crowd_source.h: 0 faces +z, pi/2 faces +x.
-float angle_of(glm::vec2 d) { return std::atan2(d.x, d.y); }
+// theta convention of crowd_source.h: 0 faces +z, pi/2 faces +x. atan2_1, not std::atan2: the
+// same bits on every machine, and no unpredictable branches in the commit pass.
+float angle_of(glm::vec2 d) { return atan2_1(d.x, d.y); }
 bool finite(glm::vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 
 Status check_range(bool ok, const char* name, const char* expected) {
