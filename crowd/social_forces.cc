@@ -200,7 +200,7 @@ Status SocialForces::step(float dt_s) {
                          ": expected a value in (0, 0.5]");
   }
   for_agents([&](size_t b, size_t e) { prepare(b, e); });
-  impl_->grid.build({position_.data(), num_});
+  impl_->grid.sort_cells(num_);
   const auto order = impl_->grid.order();
   // Gather in cell order, so that neighbours are contiguous: one record read per agent.
   for_agents([&](size_t b, size_t e) {
@@ -221,7 +221,8 @@ Status SocialForces::step(float dt_s) {
   return Status::Ok();
 }
 
-// Pass 0: the records of agents [begin, end), from their arrays read sequentially.
+// Pass 0: the records of agents [begin, end), from their arrays read sequentially, and their
+// grid cells.
 void SocialForces::prepare(size_t begin, size_t end) {
   for (size_t i = begin; i < end; ++i) {
     const glm::vec2 pos = position_[i];
@@ -233,6 +234,7 @@ void SocialForces::prepare(size_t begin, size_t end) {
     }
     body_[i] = Body{pos, velocity_[i], dir, radius_[i], desired_speed_[i]};
   }
+  impl_->grid.assign_cells({position_.data(), num_}, begin, end);  // the parallel part of build()
 }
 
 namespace {

@@ -76,19 +76,28 @@ Result<UniformGrid> UniformGrid::create(glm::vec2 min, glm::vec2 max, float cell
 }
 
 void UniformGrid::build(std::span<const glm::vec2> points) {
-  assert(points.size() <= order_.size());
-  num_points_ = points.size();
-  std::fill(cell_start_.begin(), cell_start_.end(), 0u);
-  for (size_t i = 0; i < points.size(); ++i) {
+  assign_cells(points, 0, points.size());
+  sort_cells(points.size());
+}
+
+void UniformGrid::assign_cells(std::span<const glm::vec2> points, size_t begin, size_t end) {
+  assert(end <= points.size() && points.size() <= point_cell_.size());
+  for (size_t i = begin; i < end; ++i) {
     const auto [cx, cz] = cell_of(points[i]);
-    const auto c = static_cast<uint32_t>(cz * num_x_ + cx);
-    point_cell_[i] = c;
-    ++cell_start_[c + 1];
+    point_cell_[i] = static_cast<uint32_t>(cz * num_x_ + cx);
   }
+}
+
+void UniformGrid::sort_cells(size_t num_points) {
+  assert(num_points <= order_.size());
+  num_points_ = num_points;
+  std::fill(cell_start_.begin(), cell_start_.end(), 0u);
+  for (size_t i = 0; i < num_points; ++i) ++cell_start_[point_cell_[i] + 1];
   for (size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
   std::copy(cell_start_.begin(), cell_start_.end() - 1, cursor_.begin());
-  for (size_t i = 0; i < points.size(); ++i)
+  for (size_t i = 0; i < num_points; ++i) {
     order_[cursor_[point_cell_[i]]++] = static_cast<uint32_t>(i);
+  }
 }
 
 WallGrid::WallGrid(std::span<const WallSegment> walls, float cell_size_m, float reach_m)
@@ -138,14 +147,11 @@ WallGrid::WallGrid(std::span<const WallSegment> walls, float cell_size_m, float 
   }
 }
 
-// Where an agent moving from `from` toward `to` may end up: a step that would cross a wall slides
-// along it (or is cancelled), and the end point is pushed out to `radius` from nearby walls.
-glm::vec2 WallGrid::constrain_move(glm::vec2 from, glm::vec2 to, float radius) const {
+// constrain_move() past its common case: a step that would cross a wall slides along it (or is
+// cancelled), and the end point is pushed out to `radius` from nearby walls.
+glm::vec2 WallGrid::constrain_move_near_walls(glm::vec2 from, glm::vec2 to, float radius,
+                                              std::span<const uint32_t> near_from) const {
   const WallGrid& grid = *this;
-  if (walls_.empty()) return to;
-  const std::span<const uint32_t> near_from = grid.near(from);
-  // No wall near `from` and a short move: nothing below can change `to` (the common case).
-  if (near_from.empty() && glm::length(to - from) + radius <= grid.reach()) return to;
   auto walls_for = [&](glm::vec2 target, float extra) {
     return glm::length(target - from) + extra <= grid.reach() ? near_from : grid.all();
   };

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 
 #include "common/status.h"
@@ -33,6 +34,11 @@ class UniformGrid {
   // Stable counting sort of the points into cells, O(points + cells). No allocation when
   // points.size() <= capacity (asserted).
   void build(std::span<const glm::vec2> points);
+  // build() in two steps, so that the first can run in parallel: assign_cells() for points
+  // [begin, end) of `points` (disjoint ranges may run concurrently), then sort_cells() for the
+  // first num_points, serial. The same result as build().
+  void assign_cells(std::span<const glm::vec2> points, size_t begin, size_t end);
+  void sort_cells(size_t num_points);
 
   int num_x() const { return num_x_; }
   int num_z() const { return num_z_; }
@@ -76,6 +82,8 @@ class WallGrid {
   std::span<const uint32_t> all() const { return all_; }
 
  private:
+  glm::vec2 constrain_move_near_walls(glm::vec2 from, glm::vec2 to, float radius,
+                                      std::span<const uint32_t> near_from) const;
   std::vector<WallSegment> walls_;
   std::vector<uint32_t> all_;
   glm::vec2 min_{0.0f};
@@ -120,6 +128,14 @@ inline std::span<const uint32_t> WallGrid::near(glm::vec2 p) const {
   }
   const size_t c = static_cast<size_t>(fz) * num_x_ + static_cast<size_t>(fx);
   return {items_.data() + cell_start_[c], items_.data() + cell_start_[c + 1]};
+}
+
+inline glm::vec2 WallGrid::constrain_move(glm::vec2 from, glm::vec2 to, float radius) const {
+  if (walls_.empty()) return to;
+  const std::span<const uint32_t> near_from = near(from);
+  // No wall near `from` and a short move: nothing can change `to` (the common case).
+  if (near_from.empty() && glm::length(to - from) + radius <= reach_m_) return to;
+  return constrain_move_near_walls(from, to, radius, near_from);
 }
 
 }  // namespace gk
