@@ -175,7 +175,6 @@ Result<std::unique_ptr<SocialForces>> SocialForces::create(const Scenario& scena
     s.heading_[i] = s.theta_[i] = glm::dot(to_goal, to_goal) > 0.0f ? angle_of(to_goal) : 0.0f;
   }
   s.new_velocity_.resize(n);
-  s.body_.resize(n);
   s.sorted_.resize(n);
   s.sorted_x_.assign(n + 3, 0.0f);  // a row's last group of four may read three past its end
   s.sorted_z_.assign(n + 3, 0.0f);
@@ -199,17 +198,13 @@ Status SocialForces::step(float dt_s) {
     return Status::Error("social forces: step dt_s " + std::to_string(dt_s) +
                          ": expected a value in (0, 0.5]");
   }
-  for_agents([&](size_t b, size_t e) { prepare(b, e); });
-  impl_->grid.sort_cells(num_);
-  const auto order = impl_->grid.order();
-  // Gather in cell order, so that neighbours are contiguous: one record read per agent.
+  // Agents into grid cells (the cells in parallel, the counting sort serially), then their records
+  // straight into cell order, so that neighbours are contiguous in memory.
   for_agents([&](size_t b, size_t e) {
-    for (size_t k = b; k < e; ++k) {
-      sorted_[k] = body_[order[k]];
-      sorted_x_[k] = sorted_[k].position.x;
-      sorted_z_[k] = sorted_[k].position.y;
-    }
+    impl_->grid.assign_cells({position_.data(), num_}, b, e);
   });
+  impl_->grid.sort_cells(num_);
+  for_agents([&](size_t b, size_t e) { prepare(b, e); });
   impl_->non_finite.store(false, std::memory_order_relaxed);
   for_agents([&](size_t b, size_t e) { compute_velocities(b, e, dt_s); });
   for_agents([&](size_t b, size_t e) { commit(b, e, dt_s); });
@@ -221,9 +216,10 @@ Status SocialForces::step(float dt_s) {
   return Status::Ok();
 }
 
-// Pass 0: the records of agents [begin, end), from their arrays read sequentially, and their
-// grid cells.
+// Pass 0: the records of agents [begin, end), from their arrays read sequentially, written to
+// their places in cell order (scattered writes, which do not stall like scattered reads).
 void SocialForces::prepare(size_t begin, size_t end) {
+  const auto rank = impl_->grid.rank();
   for (size_t i = begin; i < end; ++i) {
     const glm::vec2 pos = position_[i];
     glm::vec2 dir(0.0f);  // desired direction e
@@ -232,9 +228,11 @@ void SocialForces::prepare(size_t begin, size_t end) {
       const float len = glm::length(to_goal);
       if (len > 1e-6f) dir = to_goal / len;
     }
-    body_[i] = Body{pos, velocity_[i], dir, radius_[i], desired_speed_[i]};
+    const uint32_t k = rank[i];
+    sorted_[k] = Body{pos, velocity_[i], dir, radius_[i], desired_speed_[i]};
+    sorted_x_[k] = pos.x;
+    sorted_z_[k] = pos.y;
   }
-  impl_->grid.assign_cells({position_.data(), num_}, begin, end);  // the parallel part of build()
 }
 
 namespace {
@@ -274,12 +272,12 @@ struct SocialForces::ForceLanes {
         side_step(_mm_set1_ps(p.side_step)),
         stiffness(_mm_set1_ps(p.contact_forces ? p.body_stiffness_s2 : 0.0f)) {}
   void set_agent(glm::vec2 position, glm::vec2 velocity, glm::vec2 facing, float radius,
-                 uint32_t agent_id) {
+                 uint32_t agent_index) {
     px = _mm_set1_ps(position.x), pz = _mm_set1_ps(position.y);
     vx = _mm_set1_ps(velocity.x), vz = _mm_set1_ps(velocity.y);
     fx = _mm_set1_ps(facing.x), fz = _mm_set1_ps(facing.y);
     ri = _mm_set1_ps(radius);
-    id = agent_id;
+    index = agent_index;
     sum_x = sum_z = _mm_setzero_ps();
   }
   glm::vec2 total() const {
@@ -290,7 +288,7 @@ struct SocialForces::ForceLanes {
   }
   __m128 lambda, lambda_rest_half, anticipation, inv_b, strength, side_step, stiffness;
   __m128 px, pz, vx, vz, fx, fz, ri;  // the agent; its right is (-fz, fx)
-  uint32_t id = 0;
+  uint32_t index = 0;  // in the state arrays; its id_ is read only for a neighbour on its spot
   __m128 sum_x, sum_z;
 };
 
@@ -325,7 +323,7 @@ void SocialForces::add_neighbour_forces(const uint32_t* candidates, uint32_t cou
       alignas(16) float sign[4] = {1.0f, 1.0f, 1.0f, 1.0f};
       const auto order = impl_->grid.order();
       for (uint32_t l = 0; l < lanes; ++l) {
-        if (f->id < id_[order[candidates[g + l]]]) sign[l] = -1.0f;
+        if (id_[f->index] < id_[order[candidates[g + l]]]) sign[l] = -1.0f;
       }
       nx = select(same_spot, _mm_load_ps(sign), nx);
       nz = select(same_spot, zero, nz);
@@ -406,7 +404,7 @@ void SocialForces::compute_velocities(size_t begin, size_t end, float dt_s) {
     // Facing for the field of view: the velocity, or the desired direction when (nearly) still.
     const float speed = glm::length(vel);
     const glm::vec2 facing = speed > 0.1f ? vel / speed : dir;
-    forces.set_agent(pos, vel, facing, r_i, id_[i]);
+    forces.set_agent(pos, vel, facing, r_i, i);
     // The agents of the 3 x 3 cells around, three contiguous row ranges, shared by the agents of
     // one cell (they are consecutive in k).
     const auto [cx, cz] = grid.cell_of(pos);

@@ -12,10 +12,11 @@
 // One step is two whole-crowd passes over flat arrays: compute every new velocity from the frozen
 // state, then commit positions, waypoints and orientations. The velocity pass walks the agents in
 // uniform-grid cell order over a packed copy of what it reads, so neighbours are contiguous in
-// memory, and computes the neighbour forces four at a time (SSE2, the same operations as one at a
-// time). Each agent sums its neighbours in a fixed order (cell order), so results do not depend on
-// the thread count: runs with threads = 2 equal threads = 1 bit for bit. Capacity and scratch are
-// fixed at creation.
+// memory, and computes the neighbour forces four at a time (SSE2; exp and atan2 are the SSE2
+// ones of crowd/simd_exp.h and crowd/simd_atan2.h, so the bits do not depend on the CPU's libm
+// variant). Each agent sums its neighbours in a fixed order (cell order, four lane sums added up
+// in a fixed order), so results do not depend on the thread count: runs with threads = 2 equal
+// threads = 1 bit for bit. Capacity and scratch are fixed at creation.
 
 #include <cstdint>
 #include <memory>
@@ -123,14 +124,13 @@ class SocialForces final : public CrowdSource {
   std::vector<glm::vec2> waypoints_;  // all chains, immutable
   std::vector<AttentionTarget> targets_;
   // Scratch of one step. What the velocity pass reads of an agent, packed into one 32-byte record
-  // so that gathering it into cell order costs one cache line per agent: body_ in index order
-  // (written by a sequential pass), sorted_ in the grid's cell order.
+  // and stored in the grid's cell order, so that an agent's neighbours are contiguous.
   struct Body {
     glm::vec2 position, velocity;
     glm::vec2 direction;  // desired direction e toward the current waypoint; 0 when arrived
     float radius, desired_speed;
   };
-  std::vector<Body> body_, sorted_;
+  std::vector<Body> sorted_;
   std::vector<float> sorted_x_, sorted_z_;  // sorted_'s positions, for the neighbour scan
   std::vector<glm::vec2> new_velocity_;
 };

@@ -72,6 +72,7 @@ Result<UniformGrid> UniformGrid::create(glm::vec2 min, glm::vec2 max, float cell
   g.cursor_.assign(cells, 0);
   g.point_cell_.assign(capacity, 0);
   g.order_.assign(capacity, 0);
+  g.rank_.assign(capacity, 0);
   return g;
 }
 
@@ -96,7 +97,9 @@ void UniformGrid::sort_cells(size_t num_points) {
   for (size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
   std::copy(cell_start_.begin(), cell_start_.end() - 1, cursor_.begin());
   for (size_t i = 0; i < num_points; ++i) {
-    order_[cursor_[point_cell_[i]]++] = static_cast<uint32_t>(i);
+    const uint32_t k = cursor_[point_cell_[i]]++;
+    order_[k] = static_cast<uint32_t>(i);
+    rank_[i] = k;
   }
 }
 

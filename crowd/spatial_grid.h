@@ -47,6 +47,8 @@ class UniformGrid {
   std::pair<int, int> cell_of(glm::vec2 p) const;
   // Indices of the built points, ordered by cell (row-major, x fastest), within a cell by index.
   std::span<const uint32_t> order() const { return {order_.data(), num_points_}; }
+  // The inverse of order(): where point i is in it.
+  std::span<const uint32_t> rank() const { return {rank_.data(), num_points_}; }
   // Half-open range in order() covering cells x0..x1 (inclusive, clamped) of row z: one
   // contiguous range, because rows are stored consecutively.
   std::pair<uint32_t, uint32_t> row_range(int z, int x0, int x1) const;
@@ -61,6 +63,7 @@ class UniformGrid {
   std::vector<uint32_t> cursor_;      // scratch of the scatter
   std::vector<uint32_t> point_cell_;  // capacity
   std::vector<uint32_t> order_;       // capacity
+  std::vector<uint32_t> rank_;        // capacity
 };
 
 class WallGrid {

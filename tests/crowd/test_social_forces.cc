@@ -556,7 +556,8 @@ TEST(SocialForces, OneStepOfAPackedClusterFollowsTheModel) {
   EXPECT_EQ(checked, kAgents);
 }
 
-// The uniform grid's 3x3-cell search finds exactly the pairs closer than a cell, as brute force.
+// The uniform grid's 3x3-cell search finds exactly the pairs closer than a cell, as brute force;
+// rank() inverts order().
 TEST(UniformGrid, NeighbourSearchMatchesBruteForce) {
   std::vector<glm::vec2> points;
   uint64_t state = 99;
@@ -570,6 +571,7 @@ TEST(UniformGrid, NeighbourSearchMatchesBruteForce) {
   auto grid = UniformGrid::create({0.0f, 0.0f}, {50.0f, 30.0f}, 2.0f, points.size());
   ASSERT_TRUE(grid.ok());
   grid->build(points);
+  for (uint32_t i = 0; i < points.size(); ++i) ASSERT_EQ(grid->order()[grid->rank()[i]], i);
   std::set<std::pair<uint32_t, uint32_t>> found, expected;
   for (uint32_t i = 0; i < points.size(); ++i) {
     const auto [cx, cz] = grid->cell_of(points[i]);
