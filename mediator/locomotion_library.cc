@@ -446,7 +446,6 @@ LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
   return idle;
 }
 
-
 // A take's stretch (a start or a stop, with its root motion) as a transition clip: facing turned
 // to +z, the root's travel taken out frame by frame along its path smoothed over a quarter
 // second (the pelvis keeps its sway), contacts and toe heights from clip analysis of the take's
@@ -881,8 +880,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     lc.clip = make_in_place(c, sk, lc.analysis, facing);
     if (take != nullptr) lc.source = *take;
     fill_contacts_and_heights(&lc, sk);
-    const bool both_feet =
-        !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
+    const bool both_feet = !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
     char speed[64];  // "%.2f" of any float fits
     std::snprintf(speed, sizeof(speed), "%.2f m/s", lc.speed_m_s);
     const std::string no_contacts =
@@ -1009,14 +1007,16 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
         const TakeSegment& s = seg.segments[k];
         if (s.kind != SegmentKind::kStart && s.kind != SegmentKind::kStop) continue;
         const bool start = s.kind == SegmentKind::kStart;
-        const TakeSegment* idle = start ? (k > 0 ? &seg.segments[k - 1] : nullptr)
-                                        : (k + 1 < seg.segments.size() ? &seg.segments[k + 1]
-                                                                       : nullptr);
+        const TakeSegment* idle =
+            start ? (k > 0 ? &seg.segments[k - 1] : nullptr)
+                  : (k + 1 < seg.segments.size() ? &seg.segments[k + 1] : nullptr);
         if (idle != nullptr && idle->kind != SegmentKind::kIdle) idle = nullptr;
         TimeInterval span = s.span;
         if (idle != nullptr) {
-          if (start) span.start_s = std::max(idle->span.start_s, span.start_s - kTransitionRest);
-          else span.end_s = std::min(idle->span.end_s, span.end_s + kTransitionRest);
+          if (start)
+            span.start_s = std::max(idle->span.start_s, span.start_s - kTransitionRest);
+          else
+            span.end_s = std::min(idle->span.end_s, span.end_s + kTransitionRest);
         }
         if (span.end_s - span.start_s < kMinTransition) continue;
         Clip cut = extract_span(clip, span);
@@ -1075,6 +1075,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       it = lib.groups.end() - 1;
     }
     it->clips.push_back(i);
+    lib.clips[i].direction_offset_rad = wrap_pi(lib.clips[i].direction_rad - d);
     lib.max_speed_m_s = std::max(lib.max_speed_m_s, lib.clips[i].speed_m_s);
   }
   std::sort(lib.groups.begin(), lib.groups.end(),

@@ -11,8 +11,8 @@
 
 #include "animation/analysis.h"
 #include "animation/clip.h"
-#include "animation/segmentation.h"
 #include "animation/mesh.h"
+#include "animation/segmentation.h"
 
 namespace gk {
 
@@ -23,12 +23,14 @@ struct LocomotionClip {
   // The take as captured, with its root motion, on the library skeleton and floor (empty for a
   // clip authored in place): what the metrics' clip references and floors play.
   Clip source;
-  ClipAnalysis analysis;       // of the original (retargeted) clip
+  ClipAnalysis analysis;  // of the original (retargeted) clip
   // Native ground speed: for a gait clip with root motion, the speed its planted feet are carried
   // under the body at (clip analysis reports the root's; a retargeted take's feet may slide).
   float speed_m_s = 0.0f;
   float direction_rad = 0.0f;  // travel direction relative to facing (0 forward, +pi/2 left)
-  bool gait = false;           // has a gait cycle (alternating contacts) and travels
+  // direction_rad less its direction group's (a forward walk that drifts a few degrees) [rad]
+  float direction_offset_rad = 0.0f;
+  bool gait = false;  // has a gait cycle (alternating contacts) and travels
   float cycle_start_s = 0.0f;
   float cycle_s = 1.0f;  // duration of one gait cycle (stride) in clip time
   // Clip time [s] at phase k / kPhaseTableSize over one cycle (monotone, may exceed the duration of
@@ -46,8 +48,8 @@ struct LocomotionClip {
   // How far through its swing each foot is, 0 where it leaves the ground to 1 where it lands
   // (0 while planted).
   std::vector<float> swing_progress[2];
-  float toe_floor_m[2] = {0.0f, 0.0f};     // lowest toe height in the clip
-  float ankle_floor_m[2] = {0.0f, 0.0f};   // lowest ankle height in the clip
+  float toe_floor_m[2] = {0.0f, 0.0f};    // lowest toe height in the clip
+  float ankle_floor_m[2] = {0.0f, 0.0f};  // lowest ankle height in the clip
   // Why this gait clip's contact analysis is doubtful (empty when it is sound): contacts that do
   // not alternate, a cycle that is not one stride, feet down for very different times. A doubtful
   // clip is still played (its speed and cycle are usable), but no foot lock is planted on its
@@ -68,7 +70,7 @@ enum class TransitionKind : uint8_t { kStart, kStop };
 const char* transition_kind_name(TransitionKind kind);
 struct Transition {
   TransitionKind kind = TransitionKind::kStart;
-  int clip = -1;             // its clip in LocomotionLibrary::clips (LocomotionClip::transition)
+  int clip = -1;  // its clip in LocomotionLibrary::clips (LocomotionClip::transition)
   float duration_s = 0.0f;
   float fps = 30.0f;
   // The root's speed along its path [m/s] per clip frame (smoothed over a quarter second): what
@@ -169,7 +171,8 @@ bool gait_analysis_doubtful(const LocomotionLibrary& library);
 // Needs the clip's analysis and phase table.
 std::vector<std::string> gait_doubts(const LocomotionClip& clip);
 
-// One line per segmented take: its segments (kind and span), the clips cut from it, and its problems.
+// One line per segmented take: its segments (kind and span), the clips cut from it, and its
+// problems.
 std::vector<std::string> describe_takes(const LocomotionLibrary& library);
 
 // Builds the library from one or more clip sets. The first set's skeleton is the library skeleton;

@@ -218,18 +218,19 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   const float pull = root_pull(dt_s);
   if (lod) {
     // Per agent and its own slot only: in parallel, as the passes.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) {
-        const int slot = pl.slot_of_agent[i];
-        lod_plan_[slot] = lod_due_[slot] || pl.fresh[slot];
-        if (lod_plan_[slot]) {
-          lod_dt_s_[slot] = lod_step(slot, dt_s);
-        } else {
-          advance_agent(static_cast<int>(i), slot, frame.positions[i], frame.velocities[i],
-                        frame.thetas[i], dt_s, pull);
-        }
-      }
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t i = r.begin(); i < r.end(); ++i) {
+                          const int slot = pl.slot_of_agent[i];
+                          lod_plan_[slot] = lod_due_[slot] || pl.fresh[slot];
+                          if (lod_plan_[slot]) {
+                            lod_dt_s_[slot] = lod_step(slot, dt_s);
+                          } else {
+                            advance_agent(static_cast<int>(i), slot, frame.positions[i],
+                                          frame.velocities[i], frame.thetas[i], dt_s, pull);
+                          }
+                        }
+                      });
   }
 
   // The whole-crowd passes (mediator/mediator_passes.h), each over every agent due, in order.
@@ -245,15 +246,16 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   const bool honoured = params_.feedback && policy == FeedbackPolicy::kHonoured;
   root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_);
   facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw, pl.upper_yaw,
-              rel_dir_);
+              rel_dir_, pl.layer_clip, pl.layer_weight);
   weights_pass(crowd, pl.speed_m_s, rel_dir_, tr_min_cadence_, {clip_weights_, scratch_target_},
                pl.layer_clip, pl.layer_weight, pl.blend_progress);
   rate_phase_pass(crowd, pl.layer_clip, pl.layer_weight, pl.speed_m_s, cadence_scale_, pl.lower_yaw,
                   pl.phase, idle_time_, pl.playback_rate, pl.gait_weight, pl.travel_yaw);
-  transition_pass(crowd, pl.speed_m_s, pl.playback_rate, pl.standing, pl.layer_clip,
-                  pl.layer_weight, pl.gait_weight, pl.phase,
-                  {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_min_cadence_,
-                   tr_lag_, tr_prev_speed_, tr_prev_phase_, tr_still_, tr_moving_, tr_counts_});
+  transition_pass(
+      crowd, pl.speed_m_s, pl.playback_rate, pl.standing, pl.layer_clip, pl.layer_weight,
+      pl.gait_weight, pl.phase,
+      {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_min_cadence_, tr_lag_,
+       tr_prev_speed_, tr_prev_phase_, tr_still_, tr_moving_, tr_counts_});
   contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, tr_time_,
                 pl.gait_weight, pl.layer_time_s,
                 {{pl.plant[0], pl.plant[1]},

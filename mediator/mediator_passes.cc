@@ -174,7 +174,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
 void facing_pass(const PassCrowd& c, std::span<const float> root_heading,
                  std::span<const float> theta_unwrapped, std::span<const uint8_t> standing_in,
                  std::span<float> lower_target, std::span<float> lower_yaw,
-                 std::span<float> out_upper_yaw, std::span<float> out_rel_dir) {
+                 std::span<float> out_upper_yaw, std::span<float> out_rel_dir,
+                 std::span<const int16_t> layer_clip, std::span<const float> layer_weight) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);
@@ -204,6 +205,20 @@ void facing_pass(const PassCrowd& c, std::span<const float> root_heading,
           }
         }
         target = travel - best_d;
+      }
+      // The gait clips played travel a few degrees off their group's direction (a captured walk
+      // drifts): the lower body faces that much the other way, so the legs walk along v. From the
+      // layers as last planned (the weights follow the speed, not the facing).
+      if (!standing) {
+        float off = 0.0f, wsum = 0.0f;
+        for (int k = 0; k < kMaxBlendLayers; ++k) {
+          const float lw = layer_weight[slot * kMaxBlendLayers + k];
+          const LocomotionClip& clip = lib.clips[layer_clip[slot * kMaxBlendLayers + k]];
+          if (!clip.gait || !(lw > 0.0f)) continue;
+          off += lw * clip.direction_offset_rad;
+          wsum += lw;
+        }
+        if (wsum > 0.0f) target -= off / wsum;
       }
       lower_target[slot] = target;
       const float rate = glm::radians(P.lower_turn_rate_deg_s) * (standing ? 0.5f : 1.0f);
@@ -509,8 +524,8 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
         // The agent's speed, plus what the clip's root has fallen behind it (made up over
         // kLagCatchUp), over the clip's.
         const float wanted = v + st.lag_m[slot] / kLagCatchUp;
-        rate = std::clamp(wanted / std::max(clip_v, 0.05f), P.min_playback_rate,
-                          P.max_playback_rate);
+        rate =
+            std::clamp(wanted / std::max(clip_v, 0.05f), P.min_playback_rate, P.max_playback_rate);
         // A stop whose clip still walks faster than the agent hurries on to where it is as slow.
         if (!start && clip_v > 1.15f * v + 0.05f) rate = P.max_playback_rate;
       }
@@ -530,8 +545,8 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       const bool creeps = tr.speed_at(t) * P.min_playback_rate > v + kStill;
       const bool aborted =
           start ? stand || creeps
-                : !stand && ((accel > kStopDeceleration && v > 0.5f * tr.moving_speed_m_s) ||
-                             v > reach);
+                : !stand &&
+                      ((accel > kStopDeceleration && v > 0.5f * tr.moving_speed_m_s) || v > reach);
       if (over || aborted) stage = TransitionStage::kLeaving;
     }
     if (stop_seen && !start) ++counts[kStopsPlayed];  // the agent comes to rest in a stop clip
@@ -649,8 +664,9 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
 
 void feedback_pass(const PassCrowd& c, bool honoured, std::span<const glm::vec2> positions,
                    std::span<const glm::vec2> velocities, std::span<const float> thetas,
-                   std::span<float> fed_speed, std::span<const float> lower_yaw, std::span<const uint8_t> standing,
-                   std::span<const float> gait_weight, FeedbackOut out) {
+                   std::span<float> fed_speed, std::span<const float> lower_yaw,
+                   std::span<const uint8_t> standing, std::span<const float> gait_weight,
+                   FeedbackOut out) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);

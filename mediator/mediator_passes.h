@@ -144,14 +144,16 @@ void root_pass(const PassCrowd& crowd, std::span<const glm::vec2> positions,
                std::span<float> out_root_heading);
 
 // --- facing -------------------------------------------------------------------------------------
-// Reads the root's heading, the filtered theta and `standing`. Writes the lower body's target
-// and yaw psi (turned toward the target at a limited rate; APM picks the direction group that
-// leaves the torso the least twist), the upper body's yaw and the travel direction relative to psi
-// (0 standing or outside APM) [rad].
+// Reads the root's heading, the filtered theta, `standing` and last frame's layers. Writes the
+// lower body's target and yaw psi (turned toward the target at a limited rate; APM picks the
+// direction group that leaves the torso the least twist, and turns the body against the played
+// gait clips' own offset from their group's direction, so they travel along v), the upper body's
+// yaw and the travel direction relative to psi (0 standing or outside APM) [rad].
 void facing_pass(const PassCrowd& crowd, std::span<const float> root_heading,
                  std::span<const float> theta, std::span<const uint8_t> standing,
                  std::span<float> lower_target, std::span<float> lower_yaw,
-                 std::span<float> out_upper_yaw, std::span<float> out_rel_dir);
+                 std::span<float> out_upper_yaw, std::span<float> out_rel_dir,
+                 std::span<const int16_t> layer_clip, std::span<const float> layer_weight);
 
 // --- weights ------------------------------------------------------------------------------------
 // Per slot [slot * num_clips + clip]: the faded clip weights (carried) and the target ones.
@@ -165,8 +167,8 @@ struct ClipWeights {
 // A layer of weight 0 keeps the clip it had.
 void weights_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
                   std::span<const float> rel_dir, std::span<const float> min_cadence,
-                  ClipWeights weights, std::span<int16_t> layer_clip,
-                  std::span<float> layer_weight, std::span<float> out_blend_progress);
+                  ClipWeights weights, std::span<int16_t> layer_clip, std::span<float> layer_weight,
+                  std::span<float> out_blend_progress);
 
 // --- rate and phase -----------------------------------------------------------------------------
 // Reads the layers, the filtered speed, each agent's cadence scale and the lower-body yaw. Writes
@@ -201,7 +203,7 @@ struct TransitionState {
   // Waiting: the playback rate when the stop was chosen, the cadence the weights pass holds
   // until the stop begins (0: none).
   std::span<float> min_cadence;
-  std::span<float> lag_m;     // playing: the agent's distance travelled minus the clip's [m]
+  std::span<float> lag_m;  // playing: the agent's distance travelled minus the clip's [m]
   std::span<float> prev_speed_m_s, prev_phase;
   std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
   std::span<uint32_t> counts;          // [slot * kNumCounts + TransitionCount], cumulative
@@ -264,7 +266,8 @@ struct FeedbackOut {
 // limit.
 void feedback_pass(const PassCrowd& crowd, bool honoured, std::span<const glm::vec2> positions,
                    std::span<const glm::vec2> velocities, std::span<const float> thetas,
-                   std::span<float> fed_speed, std::span<const float> lower_yaw, std::span<const uint8_t> standing,
-                   std::span<const float> gait_weight, FeedbackOut out);
+                   std::span<float> fed_speed, std::span<const float> lower_yaw,
+                   std::span<const uint8_t> standing, std::span<const float> gait_weight,
+                   FeedbackOut out);
 
 }  // namespace gk

@@ -155,6 +155,33 @@ TEST(Mediator, RootFollowsTheSimulator) {
   EXPECT_LE(r.report.heading_error_deg.p95, 15.0);
 }
 
+// A captured gait travels a few degrees off the way its body faces (16_36's jog loop: -3.4 deg):
+// the lower body faces that much the other way, so the legs carry the body along v rather than
+// the clip's drift showing as a constant heading error.
+TEST(Mediator, CapturedGaitTravelsAlongVNotAlongItsDrift) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh");
+  auto lib = test::load_data_library({"clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  float drift = 0.0f;
+  for (const LocomotionClip& c : lib->clips) {
+    if (c.gait) drift = std::max(drift, std::abs(c.direction_offset_rad));
+  }
+  ASSERT_GT(glm::degrees(drift), 2.0f);  // the case this test is about
+  constexpr float kDt = 1.0f / 60.0f;
+  test::ScriptedCrowd crowd({straight({0, 0}, {0.0f, 2.8f})});
+  CrowdPipeline pipeline(*lib, MediatorParams{}, test::test_pipeline_options(1, kDt));
+  double off_deg = 0.0;
+  int n = 0;
+  for (int f = 0; f < 240; ++f) {
+    ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+    const AnimationPlans& pl = pipeline.mediator().plans();
+    if (f < 60) continue;  // the lower body has turned to its walk
+    off_deg += std::abs(glm::degrees(wrap_pi(pl.travel_yaw[pl.slot_of_agent[0]])));  // v is +z
+    ++n;
+  }
+  EXPECT_LE(off_deg / n, 0.1 * glm::degrees(drift));
+}
+
 TEST(Mediator, FeedsBackTheSpeedItCanDeliver) {
   // 9 m/s is beyond anything the clips can do (3.6 x 1.35 x 1.2 = 5.83 m/s).
   std::vector<Script> s{straight({0, 0}, {0.0f, 9.0f})};
