@@ -7,9 +7,11 @@
 #include <tbb/parallel_for.h>
 
 #include "animation/fast_atan2.h"
+#include "animation/joint_list_fk.h"
 #include "animation/pose_jobs.h"
 #include "animation/quat_sse.h"
 #include "mediator/coarse_pose.h"
+#include "mediator/heel_pivot.h"
 #include "mediator/springs.h"
 
 namespace gk {
@@ -37,11 +39,6 @@ constexpr float kDropReach = 0.99f;
 constexpr float kMaxDrop = 0.04f;       // [m]
 constexpr float kDropHalflife = 0.05f;  // [s]
 
-// A raised heel puts the toe -> ankle line at most this steep [rad] (about 57 deg, a stance
-// foot's plantarflexion at toe-off): the pivot never turns a foot past standing on its tip.
-constexpr float kMaxHeelOff = 1.0f;
-constexpr float kPi = 3.14159265358979f;
-
 // Legs straighten smoothly over the last part of their reach (soft IK): near full extension a
 // knee's position changes ever faster with the foot's distance, and a hard clamp snaps it.
 constexpr float kIkMaxExtension = 0.999f;
@@ -53,80 +50,11 @@ void settle_spring(float& x, float& v, float goal, float halflife_s, float dt) {
   critical_spring(x, v, goal, halflife_s, dt);
 }
 
-// How much more the foot may pitch up from its elevation (toe -> ankle vector d) [rad].
-float heel_room(const glm::vec3& d) {
-  const float len = glm::length(d);
-  if (len < 1e-6f) return 0.0f;
-  return std::max(0.0f, kMaxHeelOff - std::asin(std::clamp(d.y / len, -1.0f, 1.0f)));
-}
-
-// A foot whose ball is this much higher [rad of pitch] over its floor than its ankle is over its
-// own stands on its heel, rolling down onto the ball (a heel strike lands some 15-25 deg toe-up);
-// a flat foot, captured or not, is within a few degrees of 0.
-const float kOnHeelSin = std::sin(10.0f * kPi / 180.0f);
+using heel_pivot::heel_off_pivot;
+using heel_pivot::heel_to_floor;
+using heel_pivot::on_heel;
 constexpr float kHeelHalflife = 0.05f;    // [s] a raised heel settles back this fast
 constexpr float kHeelUpHalflife = 0.02f;  // [s] and rises this fast
-
-// True when a foot with its ankle and ball (toe) here stands on its heel: pitched toe-up by more
-// than kOnHeelSin against the pose the library plants it in (its floor heights).
-bool on_heel(const glm::vec3& ankle, const glm::vec3& toe, float ankle_floor, float toe_floor) {
-  const float rise = (toe.y - toe_floor) - (ankle.y - ankle_floor);
-  return rise > kOnHeelSin * glm::length(toe - ankle);
-}
-
-// The foot's pitch about its toe [rad] that lifts an ankle at toe + d to ankle_floor (0 when it is
-// already as high): the heel rises, the ball stays.
-float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle_floor) {
-  const float len = glm::length(d);
-  if (len < 1e-6f || toe.y + d.y >= ankle_floor) return 0.0f;
-  const float now = std::asin(std::clamp(d.y / len, -1.0f, 1.0f));
-  const float want = std::asin(std::clamp((ankle_floor - toe.y) / len, -1.0f, 1.0f));
-  return std::clamp(want - now, 0.0f, heel_room(d));
-}
-
-// The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
-// about the ball, as far as heel_room allows (bisection; the distance shrinks as the heel rises
-// toward the hip). Returns the pitch [rad]. `closed_form` off: every step measures the distance
-// (the reference the closed form is tested against).
-float heel_off_pivot(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
-                     float limit, bool closed_form = true) {
-  const glm::vec3 d = ankle - toe;
-  const glm::vec3 axis = glm::normalize(glm::cross(d, glm::vec3(0, 1, 0)));
-  const float room = heel_room(d);
-  auto dist = [&](float a) { return glm::length(toe + glm::angleAxis(a, axis) * d - hip); };
-  if (dist(room) > limit) return room;
-  // Each step asks whether dist(mid) > limit. The axis is square to d, so the squared distance
-  // is K + A cos a + B sin a = K + M cos(a - phi): it exceeds limit^2 where |a - phi| (wrapped)
-  // is below acos((limit^2 - K) / M). Far from that boundary the answer is certain without the
-  // rotation; within kSure of it, and near a tangency where the boundary is ill-conditioned,
-  // the step measures dist as before, so the steps, and the pitch, are the same.
-  constexpr float kSure = 1e-3f;  // [rad], against an analytic error of about 1e-5 rad
-  const glm::vec3 e = toe - hip;
-  const glm::vec3 w = glm::cross(axis, d);
-  const float k = glm::dot(e, e) + glm::dot(d, d);
-  const float a_cos = 2.0f * glm::dot(e, d), b_sin = 2.0f * glm::dot(e, w);
-  const float m = std::sqrt(a_cos * a_cos + b_sin * b_sin);
-  const float c = m > 1e-6f ? (limit * limit - k) / m : 2.0f;
-  const bool analytic = closed_form && std::abs(c) < 1.0f - 1e-3f;
-  const float phi = analytic ? std::atan2(b_sin, a_cos) : 0.0f;
-  const float half_width = analytic ? std::acos(c) : 0.0f;
-  auto beyond = [&](float a) {
-    if (analytic) {
-      float delta = a - phi;
-      if (delta > kPi) delta -= 2.0f * kPi;
-      if (delta < -kPi) delta += 2.0f * kPi;
-      const float margin = half_width - std::abs(delta);
-      if (std::abs(margin) > kSure) return margin > 0.0f;
-    }
-    return dist(a) > limit;
-  };
-  float lo = 0.0f, hi = room;
-  for (int i = 0; i < 12; ++i) {
-    const float mid = 0.5f * (lo + hi);
-    (beyond(mid) ? lo : hi) = mid;
-  }
-  return hi;
-}
 
 // A take (not a loop) replays one stride of itself: its last pose is not quite its first, so over
 // the stride's last fifth the pose one stride earlier is blended in with this weight, and the wrap
@@ -238,6 +166,19 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
         pre_twist_.push_back({j, j + 1});
       }
     }
+  }
+  if (can_twist_) {
+    pre_twist_fk_ = range_list({0, twist_range_.from}, {});
+    for (JointRange r : pre_twist_) {
+      for (int j = r.from; j < r.to; ++j) pre_twist_fk_.push_back(static_cast<int16_t>(j));
+    }
+    for (int16_t j : range_list({twist_range_.to, num_joints_}, {})) pre_twist_fk_.push_back(j);
+  }
+  for (int sides = 1; sides < 4; ++sides) {
+    auto pick = [&](int side, JointRange r) { return (sides >> side) & 1 ? r : JointRange{}; };
+    leg_fk_[sides] = range_list(pick(0, leg_above_ankle_[0]), pick(1, leg_above_ankle_[1]));
+    foot_fk_[sides] = range_list(pick(0, subtree(skeleton_.ankle(Side::kLeft))),
+                                 pick(1, subtree(skeleton_.ankle(Side::kRight))));
   }
   // The pelvis is posed before the twist and the leg IK and neither moves it (outside their
   // ranges): its heading measured for the twist is the final one.
@@ -421,15 +362,30 @@ PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
   return {joint, subtree_end_[joint]};
 }
 
-void PoseSynthesizer::fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root) {
+void PoseSynthesizer::fk_list(int slot, const std::vector<int16_t>& joints, const glm::mat4& root) {
+  const size_t J = num_joints_;
+  const size_t base = static_cast<size_t>(slot) * J;
+  LocalToModelListJob job;
+  job.skeleton = &skeleton_;
+  job.rotations = {local_rot_.data() + base, J};
+  job.translations = {local_trans_.data() + base, J};
+  job.root_transform = &root;
+  job.out_model = {world_.data() + base, J};
+  job.joints = joints;
+  job.run();
+}
+
+std::vector<int16_t> PoseSynthesizer::range_list(JointRange a, JointRange b) const {
   if (a.from >= a.to || (b.from < b.to && b.from < a.from)) std::swap(a, b);
-  if (a.from >= a.to) return;
-  if (b.from >= b.to || b.from >= a.to) {  // disjoint: one after the other
-    fk(slot, a.from, a.to, root);
-    if (b.from < b.to) fk(slot, b.from, b.to, root);
-  } else {
-    fk(slot, a.from, std::max(a.to, b.to), root);
+  if (b.from < b.to && b.from < a.to) {  // overlapping: one range
+    a.to = std::max(a.to, b.to);
+    b = {};
   }
+  std::vector<int16_t> joints;
+  for (JointRange r : {a, b}) {
+    for (int j = r.from; j < r.to; ++j) joints.push_back(static_cast<int16_t>(j));
+  }
+  return joints;
 }
 
 void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot,
@@ -459,9 +415,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool twisting = apm && detail != PoseDetail::kLight;
   if (twisting && can_twist_) {
     // The twist poses its whole range again: before it, only the joints it reads there.
-    fk(slot, 0, twist_range_.from, root);
-    for (JointRange r : pre_twist_) fk(slot, r.from, r.to, root);
-    fk(slot, twist_range_.to, num_joints_, root);
+    fk_list(slot, pre_twist_fk_, root);
   } else {
     fk(slot, 0, num_joints_, root);
   }
@@ -583,7 +537,8 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
     const glm::quat corr(c, sn * up.x, sn * up.y, sn * up.z);
     local_rot_[base + j] = normalized_product(local_rot_[base + j], corr);
   }
-  fk_ranges(slot, subtree(chain.front()), {}, root);  // the chain lies in its first joint's subtree
+  const JointRange r = subtree(chain.front());  // the chain lies in its first joint's subtree
+  fk(slot, r.from, r.to, root);
 }
 
 bool PoseSynthesizer::locks_held(int slot) const {
@@ -784,8 +739,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     local_rot_[base + hip] = normalized_product(local_rot_[base + hip], c_hip);
     local_rot_[base + knee] = normalized_product(local_rot_[base + knee], c_knee);
   }
-  fk_ranges(slot, use_ik[0] ? leg_above_ankle_[0] : JointRange{},
-            use_ik[1] ? leg_above_ankle_[1] : JointRange{}, placed);
+  const int ik_sides = (use_ik[0] ? 1 : 0) | (use_ik[1] ? 2 : 0);
+  fk_list(slot, leg_fk_[ik_sides], placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet. A leg
   // without IK keeps its shin, ankle and foot as posed.
   for (int side = 0; side < 2; ++side) {
@@ -797,8 +752,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
     local_rot_[base + ankle] = normalized_inverse_product(parent_rot, ankle_world_rot[side]);
   }
-  fk_ranges(slot, use_ik[0] ? subtree(skeleton_.ankle(Side::kLeft)) : JointRange{},
-            use_ik[1] ? subtree(skeleton_.ankle(Side::kRight)) : JointRange{}, placed);
+  fk_list(slot, foot_fk_[ik_sides], placed);
   for (int side = 0; side < 2; ++side) {
     if (!repin[side]) continue;
     const glm::vec3 toe = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);

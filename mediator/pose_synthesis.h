@@ -113,8 +113,11 @@ class PoseSynthesizer {
     int from = 0, to = 0;
   };
   JointRange subtree(int joint) const;
-  // Forward kinematics of two ranges (overlapping ones in one pass).
-  void fk_ranges(int slot, JointRange a, JointRange b, const glm::mat4& root);
+  // Forward kinematics of a slot's joints in `joints`' order (LocalToModelListJob: runs of a few
+  // joints each go four at a time across the runs, in one call).
+  void fk_list(int slot, const std::vector<int16_t>& joints, const glm::mat4& root);
+  // The joints of range a and then b (overlapping ranges as one), in order.
+  std::vector<int16_t> range_list(JointRange a, JointRange b) const;
   void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
   // Foot locks and leg IK. letting_go: the agent has left full detail, so no foot is pinned anew
   // (nor re-planted by a step); the locks it still has are let go as the clips lift each foot,
@@ -159,6 +162,10 @@ class PoseSynthesizer {
   bool pelvis_stays_ = false;  // the pelvis is outside the twist's and the leg IK's ranges
   JointRange twist_range_;
   std::vector<JointRange> pre_twist_;  // those joints, as runs of consecutive ones
+  std::vector<int16_t> pre_twist_fk_;  // all joints posed before the twist, in order
+  // The joints leg IK poses again (leg_above_ankle_) and then the feet (the ankles' subtrees), by
+  // the sides it turns (bit 0 left, bit 1 right).
+  std::vector<int16_t> leg_fk_[4], foot_fk_[4];
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;

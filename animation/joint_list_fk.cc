@@ -1,0 +1,100 @@
+#include "animation/joint_list_fk.h"
+
+#include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <xmmintrin.h>
+#endif
+
+namespace gk {
+
+bool LocalToModelListJob::validate() const {
+  if (!skeleton || !root_transform) return false;
+  const size_t n = static_cast<size_t>(skeleton->num_joints());
+  if (rotations.size() < n || translations.size() < n || out_model.size() < n) return false;
+  for (int16_t j : joints) {
+    if (j < 0 || static_cast<size_t>(j) >= n) return false;
+  }
+  return true;
+}
+
+void LocalToModelListJob::run() const {
+  const int16_t* parents = skeleton->parents.data();
+  const float* root = &(*root_transform)[0].x;
+  float* model = &(*out_model.data())[0].x;
+  const glm::quat* rot = rotations.data();
+  const glm::vec3* trans = translations.data();
+  const size_t count = joints.size();
+#if defined(__SSE2__)
+  // As LocalToModelJob: four joints' rotation matrices at once, each lane glm::mat3_cast's
+  // operations in its order, then each joint composed with its parent from its lane's entries
+  // (glm's sums in its order, the local matrix's zeros left out): the same bits.
+  const glm::quat identity(1, 0, 0, 0);
+  for (size_t i = 0; i < count; i += 4) {
+    const size_t in_group = count - i < 4 ? count - i : 4;
+    const glm::quat* q4[4];
+    for (size_t k = 0; k < 4; ++k) q4[k] = k < in_group ? rot + joints[i + k] : &identity;
+    __m128 x = _mm_loadu_ps(&q4[0]->x), y = _mm_loadu_ps(&q4[1]->x), z = _mm_loadu_ps(&q4[2]->x),
+           w = _mm_loadu_ps(&q4[3]->x);
+    _MM_TRANSPOSE4_PS(x, y, z, w);
+    const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
+    const __m128 xx = _mm_mul_ps(x, x), yy = _mm_mul_ps(y, y), zz = _mm_mul_ps(z, z);
+    const __m128 xz = _mm_mul_ps(x, z), xy = _mm_mul_ps(x, y), yz = _mm_mul_ps(y, z);
+    const __m128 wx = _mm_mul_ps(w, x), wy = _mm_mul_ps(w, y), wz = _mm_mul_ps(w, z);
+    const __m128 e[9] = {_mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz))),
+                         _mm_mul_ps(two, _mm_add_ps(xy, wz)),
+                         _mm_mul_ps(two, _mm_sub_ps(xz, wy)),
+                         _mm_mul_ps(two, _mm_sub_ps(xy, wz)),
+                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz))),
+                         _mm_mul_ps(two, _mm_add_ps(yz, wx)),
+                         _mm_mul_ps(two, _mm_add_ps(xz, wy)),
+                         _mm_mul_ps(two, _mm_sub_ps(yz, wx)),
+                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)))};
+    // Lane k of the entries broadcast in one pshufd each (the lane is a compile-time constant).
+    auto compose = [&](auto lane) __attribute__((always_inline)) {
+      constexpr int k = decltype(lane)::value;
+      auto at = [&](int r) {
+        return _mm_castsi128_ps(_mm_shuffle_epi32(_mm_castps_si128(e[r]), _MM_SHUFFLE(k, k, k, k)));
+      };
+      const int joint = joints[i + k];
+      const int parent = parents[joint];
+      const float* p = parent < 0 ? root : model + 16 * parent;
+      const __m128 p0 = _mm_loadu_ps(p), p1 = _mm_loadu_ps(p + 4), p2 = _mm_loadu_ps(p + 8),
+                   p3 = _mm_loadu_ps(p + 12);
+      auto column = [&](__m128 a, __m128 b, __m128 c) {
+        return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
+      };
+      const float* t = &trans[joint].x;
+      float* m = model + 16 * joint;
+      _mm_storeu_ps(m, column(at(0), at(1), at(2)));
+      _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
+      _mm_storeu_ps(m + 8, column(at(6), at(7), at(8)));
+      _mm_storeu_ps(
+          m + 12,
+          _mm_add_ps(column(_mm_load1_ps(t), _mm_load1_ps(t + 1), _mm_load1_ps(t + 2)), p3));
+    };
+    compose(std::integral_constant<int, 0>{});
+    if (in_group > 1) compose(std::integral_constant<int, 1>{});
+    if (in_group > 2) compose(std::integral_constant<int, 2>{});
+    if (in_group > 3) compose(std::integral_constant<int, 3>{});
+  }
+#else
+  for (size_t i = 0; i < count; ++i) {
+    const int joint = joints[i];
+    const int parent = parents[joint];
+    const glm::mat4& p = parent < 0 ? *root_transform : out_model[parent];
+    const glm::mat3 r = glm::mat3_cast(rot[joint]);
+    const glm::vec3& t = trans[joint];
+    glm::mat4& m = out_model[joint];
+    m[0] = p[0] * r[0][0] + p[1] * r[0][1] + p[2] * r[0][2];
+    m[1] = p[0] * r[1][0] + p[1] * r[1][1] + p[2] * r[1][2];
+    m[2] = p[0] * r[2][0] + p[1] * r[2][1] + p[2] * r[2][2];
+    m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
+  }
+  (void)model;
+  (void)root;
+#endif
+}
+
+}  // namespace gk
