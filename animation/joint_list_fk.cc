@@ -1,5 +1,6 @@
 #include "animation/joint_list_fk.h"
 
+#include <cstddef>
 #include <type_traits>
 
 #if defined(__SSE2__)
@@ -30,13 +31,13 @@ void LocalToModelListJob::run() const {
   // As LocalToModelJob: four joints' rotation matrices at once, each lane glm::mat3_cast's
   // operations in its order, then each joint composed with its parent from its lane's entries
   // (glm's sums in its order, the local matrix's zeros left out): the same bits.
-  const glm::quat identity(1, 0, 0, 0);
-  for (size_t i = 0; i < count; i += 4) {
-    const size_t in_group = count - i < 4 ? count - i : 4;
-    const glm::quat* q4[4];
-    for (size_t k = 0; k < 4; ++k) q4[k] = k < in_group ? rot + joints[i + k] : &identity;
-    __m128 x = _mm_loadu_ps(&q4[0]->x), y = _mm_loadu_ps(&q4[1]->x), z = _mm_loadu_ps(&q4[2]->x),
-           w = _mm_loadu_ps(&q4[3]->x);
+  // Indices as ptrdiff_t, read before the group's stores (may-alias vector stores would have
+  // them read again): no reloads and sign extensions per joint.
+  const float* t3 = &trans->x;
+  auto group = [&](const int16_t* idx, int n) __attribute__((always_inline)) {
+    const ptrdiff_t j4[4] = {idx[0], idx[1], idx[2], idx[3]};
+    __m128 x = _mm_loadu_ps(&rot[j4[0]].x), y = _mm_loadu_ps(&rot[j4[1]].x),
+           z = _mm_loadu_ps(&rot[j4[2]].x), w = _mm_loadu_ps(&rot[j4[3]].x);
     _MM_TRANSPOSE4_PS(x, y, z, w);
     const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
     const __m128 xx = _mm_mul_ps(x, x), yy = _mm_mul_ps(y, y), zz = _mm_mul_ps(z, z);
@@ -57,15 +58,15 @@ void LocalToModelListJob::run() const {
       auto at = [&](int r) {
         return _mm_castsi128_ps(_mm_shuffle_epi32(_mm_castps_si128(e[r]), _MM_SHUFFLE(k, k, k, k)));
       };
-      const int joint = joints[i + k];
-      const int parent = parents[joint];
+      const ptrdiff_t joint = j4[k];
+      const ptrdiff_t parent = parents[joint];
       const float* p = parent < 0 ? root : model + 16 * parent;
       const __m128 p0 = _mm_loadu_ps(p), p1 = _mm_loadu_ps(p + 4), p2 = _mm_loadu_ps(p + 8),
                    p3 = _mm_loadu_ps(p + 12);
       auto column = [&](__m128 a, __m128 b, __m128 c) {
         return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
       };
-      const float* t = &trans[joint].x;
+      const float* t = t3 + 3 * joint;
       float* m = model + 16 * joint;
       _mm_storeu_ps(m, column(at(0), at(1), at(2)));
       _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
@@ -75,9 +76,17 @@ void LocalToModelListJob::run() const {
           _mm_add_ps(column(_mm_load1_ps(t), _mm_load1_ps(t + 1), _mm_load1_ps(t + 2)), p3));
     };
     compose(std::integral_constant<int, 0>{});
-    if (in_group > 1) compose(std::integral_constant<int, 1>{});
-    if (in_group > 2) compose(std::integral_constant<int, 2>{});
-    if (in_group > 3) compose(std::integral_constant<int, 3>{});
+    if (n > 1) compose(std::integral_constant<int, 1>{});
+    if (n > 2) compose(std::integral_constant<int, 2>{});
+    if (n > 3) compose(std::integral_constant<int, 3>{});
+  };
+  const int16_t* list = joints.data();
+  size_t i = 0;
+  for (; i + 4 <= count; i += 4) group(list + i, 4);
+  if (i < count) {  // the last one to three, padded with the first of them (not composed)
+    int16_t tail[4] = {list[i], list[i], list[i], list[i]};
+    for (size_t k = i; k < count; ++k) tail[k - i] = list[k];
+    group(tail, static_cast<int>(count - i));
   }
 #else
   for (size_t i = 0; i < count; ++i) {
