@@ -19,6 +19,9 @@ namespace gk {
 struct PoseSynthesizer::Scratch {
   std::vector<glm::quat> rot;    // 2 * kMaxBlendLayers * joints (a layer and its seam sample)
   std::vector<glm::vec3> trans;  // 2 * kMaxBlendLayers * joints
+  // The agent's local translations: needed only while it is posed, so kept per thread (in the
+  // caches) rather than per slot (a crowd's worth of memory traffic each frame).
+  std::vector<glm::vec3> local_trans;
   std::vector<glm::quat> coarse_rot;    // the coarse joints' blended pose (pose_coarse)
   std::vector<glm::vec3> coarse_trans;
 };
@@ -99,7 +102,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     for (size_t j = 0; j < J; ++j) inverse_bind_[j] = glm::inverse(rest[j]);
   }
   local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
-  local_trans_.assign(capacity * J, glm::vec3(0.0f));
   prev_local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
   world_.assign(capacity * J, glm::mat4(1.0f));
   if (make_palettes_) palette_.assign(capacity * J, glm::mat4(1.0f));
@@ -125,6 +127,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     Scratch s;
     s.rot.resize(2 * kMaxBlendLayers * J);
     s.trans.resize(2 * kMaxBlendLayers * J);
+    s.local_trans.resize(J);
     s.coarse_rot.resize(K);
     s.coarse_trans.resize(K);
     return s;
@@ -251,7 +254,6 @@ void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot,
   prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
   if (coarse) return;
   prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
-  prefetch_bytes(local_trans_.data() + base, J * sizeof(glm::vec3), true);
   // Far agents (kLight) keep no rotation history: max_rotation_change is for the pop metric, which
   // measures agents near the camera.
   if (d != PoseDetail::kFull && d != PoseDetail::kNoFootLocks) return;
@@ -344,13 +346,14 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
   BlendPosesJob{{layers, static_cast<size_t>(num_samples)}, out_rot, out_trans}.run();
 }
 
-void PoseSynthesizer::fk(int slot, int from, int to, const glm::mat4& root) {
+void PoseSynthesizer::fk(int slot, const glm::vec3* trans, int from, int to,
+                         const glm::mat4& root) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   LocalToModelJob job;
   job.skeleton = &skeleton_;
   job.rotations = {local_rot_.data() + base, J};
-  job.translations = {local_trans_.data() + base, J};
+  job.translations = {trans, J};
   job.root_transform = root;
   job.out_model = {world_.data() + base, J};
   job.from = from;
@@ -363,13 +366,14 @@ PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
   return {joint, subtree_end_[joint]};
 }
 
-void PoseSynthesizer::fk_list(int slot, const std::vector<int16_t>& joints, const glm::mat4& root) {
+void PoseSynthesizer::fk_list(int slot, const glm::vec3* trans,
+                              const std::vector<int16_t>& joints, const glm::mat4& root) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   LocalToModelListJob job;
   job.skeleton = &skeleton_;
   job.rotations = {local_rot_.data() + base, J};
-  job.translations = {local_trans_.data() + base, J};
+  job.translations = {trans, J};
   job.root_transform = &root;
   job.out_model = {world_.data() + base, J};
   job.joints = joints;
@@ -404,8 +408,8 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   }
 
   // Sample and blend the planned layers.
-  sample_layers(pl, slot, /*coarse=*/false, s, local_rot_.data() + base, local_trans_.data() + base,
-                J);
+  const glm::vec3* trans = s.local_trans.data();
+  sample_layers(pl, slot, /*coarse=*/false, s, local_rot_.data() + base, s.local_trans.data(), J);
 
   const bool apm = P.mode == MediatorMode::kApm;
   const bool locking = apm && P.foot_locking && detail == PoseDetail::kFull;
@@ -416,18 +420,18 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool twisting = apm && detail != PoseDetail::kLight;
   if (twisting && can_twist_) {
     // The twist poses its whole range again: before it, only the joints it reads there.
-    fk_list(slot, pre_twist_fk_, root);
+    fk_list(slot, trans, pre_twist_fk_, root);
   } else {
-    fk(slot, 0, num_joints_, root);
+    fk(slot, trans, 0, num_joints_, root);
   }
   if (twisting) {
-    twist_spine(slot, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
+    twist_spine(slot, trans, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
   // Leaving full detail, the locks are let go through their releases (a reset would snap each
   // pinned foot to the clip's at once); once every foot is free the agent runs without them.
   const bool letting_go = apm && P.foot_locking && detail == PoseDetail::kNoFootLocks &&
                           !pl.fresh[slot] && locks_held(slot);
-  if (locking || letting_go) lock_feet(pl, P, slot, root, dt, letting_go);
+  if (locking || letting_go) lock_feet(pl, P, slot, trans, root, dt, letting_go);
   // The twist measured the pelvis's heading, and nothing since moved the pelvis.
   finish_pose(slot, detail, locking || letting_go, twisting && can_twist_ && pelvis_stays_);
 }
@@ -512,7 +516,8 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   finish_pose(slot, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
 }
 
-void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit) {
+void PoseSynthesizer::twist_spine(int slot, const glm::vec3* trans, const glm::mat4& root,
+                                  float upper_yaw, float limit) {
   const std::vector<int16_t>& chain = skeleton_.spine_chain;
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (chain.empty() || hips < 0 || chest < 0) return;
@@ -540,7 +545,7 @@ void PoseSynthesizer::twist_spine(int slot, const glm::mat4& root, float upper_y
     local_rot_[base + j] = normalized_product(local_rot_[base + j], corr);
   }
   const JointRange r = subtree(chain.front());  // the chain lies in its first joint's subtree
-  fk(slot, r.from, r.to, root);
+  fk(slot, trans, r.from, r.to, root);
 }
 
 bool PoseSynthesizer::locks_held(int slot) const {
@@ -552,7 +557,8 @@ bool PoseSynthesizer::locks_held(int slot) const {
 }
 
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
-                                const glm::mat4& root, float dt, bool letting_go) {
+                                const glm::vec3* trans, const glm::mat4& root, float dt,
+                                bool letting_go) {
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
                           library_.swing_height_m, library_.swing_speed_m_s, P.lock_release_s};
@@ -742,7 +748,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     local_rot_[base + knee] = normalized_product(local_rot_[base + knee], c_knee);
   }
   const int ik_sides = (use_ik[0] ? 1 : 0) | (use_ik[1] ? 2 : 0);
-  fk_list(slot, leg_fk_[ik_sides], placed);
+  fk_list(slot, trans, leg_fk_[ik_sides], placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet. A leg
   // without IK keeps its shin, ankle and foot as posed.
   for (int side = 0; side < 2; ++side) {
@@ -754,7 +760,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::quat parent_rot = rotation_of(world_[base + parent]);
     local_rot_[base + ankle] = normalized_inverse_product(parent_rot, ankle_world_rot[side]);
   }
-  fk_list(slot, foot_fk_[ik_sides], placed);
+  fk_list(slot, trans, foot_fk_[ik_sides], placed);
   for (int side = 0; side < 2; ++side) {
     if (!repin[side]) continue;
     const glm::vec3 toe = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);

@@ -106,8 +106,9 @@ class PoseSynthesizer {
                      glm::quat* out_rot, glm::vec3* out_trans, size_t n);
   // pelvis_known: pelvis_heading_[slot] is already this pose's (twist_spine measured it).
   void finish_pose(int slot, PoseDetail detail, bool locking, bool pelvis_known);
-  // Forward kinematics of joints [from, to) of a slot (their parents outside it are current).
-  void fk(int slot, int from, int to, const glm::mat4& root);
+  // Forward kinematics of joints [from, to) of a slot (their parents outside it are current);
+  // `trans`: the slot's local translations (the posing thread's scratch).
+  void fk(int slot, const glm::vec3* trans, int from, int to, const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
   struct JointRange {
     int from = 0, to = 0;
@@ -115,15 +116,17 @@ class PoseSynthesizer {
   JointRange subtree(int joint) const;
   // Forward kinematics of a slot's joints in `joints`' order (LocalToModelListJob: runs of a few
   // joints each go four at a time across the runs, in one call).
-  void fk_list(int slot, const std::vector<int16_t>& joints, const glm::mat4& root);
+  void fk_list(int slot, const glm::vec3* trans, const std::vector<int16_t>& joints,
+               const glm::mat4& root);
   // The joints of range a and then b (overlapping ranges as one), in order.
   std::vector<int16_t> range_list(JointRange a, JointRange b) const;
-  void twist_spine(int slot, const glm::mat4& root, float upper_yaw, float limit_rad);
+  void twist_spine(int slot, const glm::vec3* trans, const glm::mat4& root, float upper_yaw,
+                   float limit_rad);
   // Foot locks and leg IK. letting_go: the agent has left full detail, so no foot is pinned anew
   // (nor re-planted by a step); the locks it still has are let go as the clips lift each foot,
   // through the usual release, so nothing snaps.
-  void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, const glm::mat4& root,
-                 float dt, bool letting_go = false);
+  void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
+                 const glm::vec3* trans, const glm::mat4& root, float dt, bool letting_go = false);
   // Any foot of the slot still pinned, stepping or shedding a release offset.
   bool locks_held(int slot) const;
 
@@ -134,7 +137,6 @@ class PoseSynthesizer {
   std::vector<glm::vec3> rest_forward_;  // per joint, +z of the rest pose in the joint's frame
   std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::quat> local_rot_;
-  std::vector<glm::vec3> local_trans_;
   std::vector<glm::quat> prev_local_rot_;
   std::vector<glm::mat4> world_;
   std::vector<glm::mat4> palette_;
