@@ -8,6 +8,8 @@
 #include <xmmintrin.h>
 #endif
 
+#include "animation/quat_sse.h"
+
 namespace gk {
 
 bool LocalToModelListJob::validate() const {
@@ -39,19 +41,8 @@ void LocalToModelListJob::run() const {
     __m128 x = _mm_loadu_ps(&rot[j4[0]].x), y = _mm_loadu_ps(&rot[j4[1]].x),
            z = _mm_loadu_ps(&rot[j4[2]].x), w = _mm_loadu_ps(&rot[j4[3]].x);
     _MM_TRANSPOSE4_PS(x, y, z, w);
-    const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
-    const __m128 xx = _mm_mul_ps(x, x), yy = _mm_mul_ps(y, y), zz = _mm_mul_ps(z, z);
-    const __m128 xz = _mm_mul_ps(x, z), xy = _mm_mul_ps(x, y), yz = _mm_mul_ps(y, z);
-    const __m128 wx = _mm_mul_ps(w, x), wy = _mm_mul_ps(w, y), wz = _mm_mul_ps(w, z);
-    const __m128 e[9] = {_mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz))),
-                         _mm_mul_ps(two, _mm_add_ps(xy, wz)),
-                         _mm_mul_ps(two, _mm_sub_ps(xz, wy)),
-                         _mm_mul_ps(two, _mm_sub_ps(xy, wz)),
-                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz))),
-                         _mm_mul_ps(two, _mm_add_ps(yz, wx)),
-                         _mm_mul_ps(two, _mm_add_ps(xz, wy)),
-                         _mm_mul_ps(two, _mm_sub_ps(yz, wx)),
-                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)))};
+    __m128 e[9];
+    quat_sse::rotation_entries4(x, y, z, w, e);
     // Lane k of the entries broadcast in one pshufd each (the lane is a compile-time constant).
     auto compose = [&](auto lane) __attribute__((always_inline)) {
       constexpr int k = decltype(lane)::value;

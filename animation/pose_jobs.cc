@@ -495,19 +495,8 @@ void LocalToModelJob::run() const {
   auto group = [&](int first, const glm::quat* q4, const float* t4, int count)
       __attribute__((always_inline)) {
     const Quat4 q = load4(q4);
-    const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
-    const __m128 xx = _mm_mul_ps(q.x, q.x), yy = _mm_mul_ps(q.y, q.y), zz = _mm_mul_ps(q.z, q.z);
-    const __m128 xz = _mm_mul_ps(q.x, q.z), xy = _mm_mul_ps(q.x, q.y), yz = _mm_mul_ps(q.y, q.z);
-    const __m128 wx = _mm_mul_ps(q.w, q.x), wy = _mm_mul_ps(q.w, q.y), wz = _mm_mul_ps(q.w, q.z);
-    const __m128 e[9] = {_mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz))),
-                         _mm_mul_ps(two, _mm_add_ps(xy, wz)),
-                         _mm_mul_ps(two, _mm_sub_ps(xz, wy)),
-                         _mm_mul_ps(two, _mm_sub_ps(xy, wz)),
-                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz))),
-                         _mm_mul_ps(two, _mm_add_ps(yz, wx)),
-                         _mm_mul_ps(two, _mm_add_ps(xz, wy)),
-                         _mm_mul_ps(two, _mm_sub_ps(yz, wx)),
-                         _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)))};
+    __m128 e[9];
+    quat_sse::rotation_entries4(q.x, q.y, q.z, q.w, e);
     const __m128 t[3] = {_mm_loadu_ps(t4), _mm_loadu_ps(t4 + 4), _mm_loadu_ps(t4 + 8)};
     compose(first, e, t, std::integral_constant<int, 0>{});
     if (count > 1) compose(first + 1, e, t, std::integral_constant<int, 1>{});

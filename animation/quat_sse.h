@@ -62,6 +62,24 @@ inline __m128 normalize(__m128 q) {
   return _mm_mul_ps(q, _mm_div_ps(_mm_set1_ps(1.0f), len));
 }
 
+// glm::mat3_cast's nine entries (m[0][0], m[0][1], m[0][2], m[1][0], ..., column by column) of
+// four quaternions, one per lane of x, y, z, w: each lane glm's operations in its order (FK).
+inline void rotation_entries4(__m128 x, __m128 y, __m128 z, __m128 w, __m128 e[9]) {
+  const __m128 one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
+  const __m128 xx = _mm_mul_ps(x, x), yy = _mm_mul_ps(y, y), zz = _mm_mul_ps(z, z);
+  const __m128 xz = _mm_mul_ps(x, z), xy = _mm_mul_ps(x, y), yz = _mm_mul_ps(y, z);
+  const __m128 wx = _mm_mul_ps(w, x), wy = _mm_mul_ps(w, y), wz = _mm_mul_ps(w, z);
+  e[0] = _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(yy, zz)));
+  e[1] = _mm_mul_ps(two, _mm_add_ps(xy, wz));
+  e[2] = _mm_mul_ps(two, _mm_sub_ps(xz, wy));
+  e[3] = _mm_mul_ps(two, _mm_sub_ps(xy, wz));
+  e[4] = _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, zz)));
+  e[5] = _mm_mul_ps(two, _mm_add_ps(yz, wx));
+  e[6] = _mm_mul_ps(two, _mm_add_ps(xz, wy));
+  e[7] = _mm_mul_ps(two, _mm_sub_ps(yz, wx));
+  e[8] = _mm_sub_ps(one, _mm_mul_ps(two, _mm_add_ps(xx, yy)));
+}
+
 }  // namespace quat_sse
 #endif
 

@@ -8,21 +8,15 @@
 #include <gtest/gtest.h>
 
 #include "crowd/simd_atan2.h"
+#include "tests/crowd/float_ulps.h"
 
 namespace gk {
 namespace {
 
-int64_t ordered(float f) {
-  int32_t i;
-  std::memcpy(&i, &f, sizeof i);
-  return i < 0 ? -int64_t(i & 0x7fffffff) : int64_t(i);
-}
-int64_t ulps(float a, float b) { return std::llabs(ordered(a) - ordered(b)); }
-float from_bits(uint32_t b) {
-  float f;
-  std::memcpy(&f, &b, sizeof f);
-  return f;
-}
+using test::from_bits;
+using test::ordered;
+using test::ulps;
+
 
 TEST(SimdAtan2, WithinTwoUlpOverAllQuadrants) {
   int64_t checked = 0, worst = 0, worst_lib = 0;

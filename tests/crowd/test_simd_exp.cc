@@ -9,23 +9,15 @@
 #include <gtest/gtest.h>
 
 #include "crowd/simd_exp.h"
+#include "tests/crowd/float_ulps.h"
 
 namespace gk {
 namespace {
 
-// Floats as integers in the order of the reals, so that ulps are a difference.
-int64_t ordered(float f) {
-  int32_t i;
-  std::memcpy(&i, &f, sizeof i);
-  return i < 0 ? -int64_t(i & 0x7fffffff) : int64_t(i);
-}
-int64_t ulps(float a, float b) { return std::llabs(ordered(a) - ordered(b)); }
+using test::from_bits;
+using test::ulps;
+
 float correctly_rounded_exp(float x) { return static_cast<float>(std::exp(double(x))); }
-float from_bits(uint32_t b) {
-  float f;
-  std::memcpy(&f, &b, sizeof f);
-  return f;
-}
 
 void expect_close(float x) {
   const float got = exp1(x);
