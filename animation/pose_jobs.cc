@@ -648,38 +648,7 @@ void SkinningPaletteJob::run() const {
     return;
   }
 #if defined(__SSE2__)
-  const bool stream = stream_out && reinterpret_cast<uintptr_t>(out_palette.data()) % 16 == 0;
-  if (inverse_bind_splat.size() == 12 * model.size() &&
-      reinterpret_cast<uintptr_t>(inverse_bind_splat.data()) % 16 == 0) {
-    // The loop below with the broadcast entries read from the splat (aligned memory operands):
-    // twelve shuffles per joint fewer.
-    const float* a = &(*model.data())[0].x;
-    const float* s = &inverse_bind_splat.data()->x;
-    float* m = &(*out_palette.data())[0].x;
-    const float* const a_end = a + 16 * model.size();
-    auto each = [&](auto streamed) {
-      for (; a != a_end; a += 16, s += 48, m += 16) {
-        const __m128 a0 = _mm_loadu_ps(a), a1 = _mm_loadu_ps(a + 4), a2 = _mm_loadu_ps(a + 8),
-                     a3 = _mm_loadu_ps(a + 12);
-        for (int c = 0; c < 4; ++c) {
-          const float* b = s + 12 * c;
-          __m128 col = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, _mm_load_ps(b)),
-                                             _mm_mul_ps(a1, _mm_load_ps(b + 4))),
-                                  _mm_mul_ps(a2, _mm_load_ps(b + 8)));
-          if (c == 3) col = _mm_add_ps(col, a3);
-          if constexpr (decltype(streamed)::value) {
-            _mm_stream_ps(m + 4 * c, col);
-          } else {
-            _mm_storeu_ps(m + 4 * c, col);
-          }
-        }
-      }
-    };
-    stream ? each(std::true_type{}) : each(std::false_type{});
-    if (stream && fence) stream_fence();
-    return;
-  }
-  if (stream) {
+  if (stream_out && reinterpret_cast<uintptr_t>(out_palette.data()) % 16 == 0) {
     // The arrays through locals: after a streamed store (may-alias) members would be read again.
     const float* a = &(*model.data())[0].x;
     const float* b = &(*inverse_bind.data())[0].x;
@@ -712,17 +681,6 @@ void SkinningPaletteJob::run() const {
     m[2] = a[0] * b[2][0] + a[1] * b[2][1] + a[2] * b[2][2];
     m[3] = a[0] * b[3][0] + a[1] * b[3][1] + a[2] * b[3][2] + a[3];
   }
-}
-
-std::vector<glm::vec4> splat_inverse_bind(std::span<const glm::mat4> inverse_bind) {
-  std::vector<glm::vec4> out;
-  out.reserve(12 * inverse_bind.size());
-  for (const glm::mat4& b : inverse_bind) {
-    for (int c = 0; c < 4; ++c) {
-      for (int r = 0; r < 3; ++r) out.push_back(glm::vec4(b[c][r]));
-    }
-  }
-  return out;
 }
 
 void stream_fence() {

@@ -4,7 +4,6 @@
 // passes call them per agent in parallel.
 
 #include <span>
-#include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
@@ -124,16 +123,9 @@ struct SkinningPaletteJob {
   // Off, the caller fences once after many palettes (stream_fence()): a fence per palette waits
   // for each one's stores to reach memory.
   bool fence = true;
-  // Optional, with affine_inverse_bind: splat_inverse_bind(inverse_bind), read in place of the
-  // entries broadcast for every palette (a crowd shares one rig). The same numbers.
-  std::span<const glm::vec4> inverse_bind_splat;
   bool validate() const;
   void run() const;
 };
-
-// The entries of affine inverse binds a palette product reads (columns 0-3, rows 0-2), each in
-// all four lanes: 12 per joint, for SkinningPaletteJob::inverse_bind_splat.
-std::vector<glm::vec4> splat_inverse_bind(std::span<const glm::mat4> inverse_bind);
 
 // Orders the streamed stores of SkinningPaletteJobs run with fence off before what follows.
 void stream_fence();

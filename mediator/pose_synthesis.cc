@@ -194,7 +194,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     }
   }
   affine_inverse_bind_ = is_affine(inverse_bind_);
-  if (affine_inverse_bind_) inverse_bind_splat_ = splat_inverse_bind(inverse_bind_);
   // A crowd's palettes far larger than the caches are written past them (read only by the
   // upload, after the whole crowd is posed); a small crowd's stay cached for it.
   stream_palettes_ = palette_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
@@ -492,7 +491,6 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, boo
     job.affine_inverse_bind = affine_inverse_bind_;
     job.stream_out = stream_palettes_;
     job.fence = false;  // run() fences once per range of agents
-    job.inverse_bind_splat = inverse_bind_splat_;
     job.run();
   }
 }

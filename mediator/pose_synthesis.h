@@ -170,7 +170,6 @@ class PoseSynthesizer {
   std::vector<int16_t> leg_fk_[4], foot_fk_[4];
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
-  std::vector<glm::vec4> inverse_bind_splat_;  // splat_inverse_bind(inverse_bind_) when affine
   bool stream_palettes_ = false;
 };
 
