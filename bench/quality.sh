@@ -4,6 +4,7 @@
 # CMU clips and the CMU subject-16 set (clips/bvh/more), in naive and apm modes, 60 Hz, 600 frames,
 # with the METRICS.md v1 and v2 columns (v2 floors of the library's own clips in brackets). Writes a Markdown table (stdout, and
 # bench/quality.md unless QUALITY_OUT is set) and keeps every JSON report in $QUALITY_DIR.
+# QUALITY_ARGS adds arguments to every run (e.g. "--set max_playback_rate=1.5").
 # Usage: bench/quality.sh [--frames F] [--agents N]   (needs jq and a built ./build/app/gaitkeeper)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -55,7 +56,7 @@ for run in "${runs[@]}"; do
       json="$dir/${name}_${sim}_${cs}_${mode}.json"
       echo "[$k/$total] $name $sim $cs $mode" >&2
       # shellcheck disable=SC2086
-      if ! $gk bench $args ${clipsets[$cs]} --mode $mode --frames "$frames" --json "$json" >/dev/null 2>"$json.err"; then
+      if ! $gk bench $args ${clipsets[$cs]} ${QUALITY_ARGS:-} --mode $mode --frames "$frames" --json "$json" >/dev/null 2>"$json.err"; then
         echo "| $name | $sim | $cs | $mode | failed: $(tail -1 "$json.err") |||||||||||||||" >> "$out.tmp"
         continue
       fi
