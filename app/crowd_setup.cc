@@ -94,7 +94,8 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
   CLI::Option* scenario = cmd->add_option(
       "--scenario", o->scenario,
       "Scenario name (data/scenarios, or $GAITKEEPER_SCENARIOS), a scenario .json file, "
-      "or an ETH/UCY trajectory .txt file to replay");
+      "or an ETH/UCY trajectory .txt file to replay (frame id x y, or the ETH authors' 8-column "
+      "obsmat.txt)");
   if (scenario_required) scenario->required();
   cmd->add_option("--sim", o->sim, "Crowd simulator: social (default) or detour");
   cmd->add_option("--agents", o->agents,
@@ -156,6 +157,12 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed, float b
     fail(cmd, 2, "--sim: expected 'social' or 'detour', got '" + o.sim + "'");
   }
   CrowdSetup src;
+  if (ends_with(o.scenario, ".vsp")) {
+    fail(cmd, 2,
+         o.scenario +
+             ": UCY spline annotations (.vsp, pixels) are not read; replay the file in metres "
+             "(frame id x y per line, e.g. ../shared/data/trajectories/zara1/crowds_zara01.txt)");
+  }
   if (ends_with(o.scenario, ".txt")) {
     if (o.sim != "social") {
       fail(cmd, 2, "--sim " + o.sim + " needs a scenario, not a trajectory file");

@@ -122,7 +122,7 @@ void DemoApp::panel_crowd() {
     row("trajectory file");
     ImGui::InputText("##trajectory", &replay_path_);
     help_marker(
-        "An ETH/UCY trajectory .txt file (frame id x y), e.g. "
+        "An ETH/UCY trajectory .txt file (frame id x y, or ETH's 8-column obsmat.txt), e.g. "
         "../shared/data/trajectories/zara1/crowds_zara01.txt");
     if (ImGui::Button("browse...##trajectory")) {
       browser_.open("Trajectory file", browse_start(replay_path_, "trajectories"), {".txt"},

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The quality matrix of the mediator: every built-in scenario on both simulators and every
-# trajectory file in the shared data, with the built-in clips, the mannequin glTF clips, the two
+# trajectory file in the shared data (the Social-GAN .txt files and ETH's original obsmat.txt), with the built-in clips, the mannequin glTF clips, the two
 # CMU clips and the CMU subject-16 set (clips/bvh/more), in naive and apm modes, 60 Hz, 600 frames,
 # with the METRICS.md v1 and v2 columns (v2 floors of the library's own clips in brackets). Writes a Markdown table (stdout, and
 # bench/quality.md unless QUALITY_OUT is set) and keeps every JSON report in $QUALITY_DIR.
@@ -39,6 +39,10 @@ for f in "$data"/trajectories/*/*.txt; do
   ft=0.4
   [[ $(basename "$f") == biwi_eth.txt ]] && ft=0.667  # PROVENANCE.md: one step spans 0.667 s
   runs+=("$(basename "$f" .txt)|--scenario $f --trajectory-frame-time $ft|replay")
+done
+# The ETH authors' own annotations (every 6 or 10 video frames, 0.4 s apart).
+for f in "$data"/trajectories/*/original/obsmat.txt; do
+  runs+=("$(basename "$(dirname "$(dirname "$f")")")_obsmat|--scenario $f|replay")
 done
 
 {

@@ -61,19 +61,42 @@ Status parse_number(std::string_view token, const char* column, const std::strin
   return Status::Ok();
 }
 
-Status parse_row(std::string_view text, const std::string& file, int line, Row* out_row) {
-  std::string_view tokens[4];
-  const int count = split_tokens(text, tokens, 4);
-  if (count != 4) {
+// The two layouts a trajectory file may have (all of its rows alike): the common one of the
+// Social-LSTM/GAN releases, and the ETH (BIWI) authors' obsmat.txt, whose ground plane is
+// (pos_x, pos_y) and whose pos_z and velocity columns are not used (the replay derives velocity
+// from the positions).
+enum class Layout : uint8_t { kFrameIdXY = 4, kObsmat = 8 };
+
+constexpr const char* kLayouts =
+    "expected 4 numbers (frame id x y) or 8 (ETH obsmat: frame id pos_x pos_z pos_y v_x v_z v_y)";
+
+Status parse_row(std::string_view text, const std::string& file, int line, Layout* layout,
+                 Row* out_row) {
+  constexpr int kMaxTokens = 8;
+  std::string_view tokens[kMaxTokens];
+  const int count = split_tokens(text, tokens, kMaxTokens);
+  if (count != 4 && count != 8) {
+    return Status::AtLine(file, line, std::string(kLayouts) + ", found " + std::to_string(count));
+  }
+  if (*layout == Layout{}) *layout = static_cast<Layout>(count);
+  if (count != static_cast<int>(*layout)) {
     return Status::AtLine(file, line,
-                          "expected 4 numbers (frame id x y), found " + std::to_string(count));
+                          "expected " + std::to_string(static_cast<int>(*layout)) +
+                              " numbers as on the file's first row, found " +
+                              std::to_string(count));
   }
-  static constexpr const char* kColumns[4] = {"column 1 (frame)", "column 2 (id)", "column 3 (x)",
-                                              "column 4 (y)"};
-  double values[4];
-  for (int c = 0; c < 4; ++c) {
-    GK_RETURN_IF_ERROR(parse_number(tokens[c], kColumns[c], file, line, &values[c]));
+  static constexpr const char* kColumns[4] = {"column 1 (frame)", "column 2 (id)",
+                                              "column 3 (x)", "column 4 (y)"};
+  static constexpr const char* kObsmatColumns[8] = {
+      "column 1 (frame)", "column 2 (id)",  "column 3 (pos_x)", "column 4 (pos_z)",
+      "column 5 (pos_y)", "column 6 (v_x)", "column 7 (v_z)",   "column 8 (v_y)"};
+  const char* const* names = count == 8 ? kObsmatColumns : kColumns;
+  double values[kMaxTokens];
+  for (int c = 0; c < count; ++c) {
+    GK_RETURN_IF_ERROR(parse_number(tokens[c], names[c], file, line, &values[c]));
   }
+  // Ground-plane columns: x and y, or obsmat's pos_x and pos_y.
+  const int gx = 2, gy = count == 8 ? 4 : 3;
   if (values[0] < 0.0 || values[0] > kMaxFrame || values[0] != std::floor(values[0])) {
     return Status::AtLine(file, line,
                           "column 1 (frame): expected a whole number in [0, 2^31), found " +
@@ -84,16 +107,16 @@ Status parse_row(std::string_view text, const std::string& file, int line, Row* 
         file, line,
         "column 2 (id): expected a whole number in [0, 2^32), found " + quoted_snippet(tokens[1]));
   }
-  for (int c = 2; c < 4; ++c) {
+  for (const int c : {gx, gy}) {
     if (std::abs(values[c]) > kMaxCoordinate_m) {
       return Status::AtLine(file, line,
-                            std::string(kColumns[c]) + ": expected a coordinate within +-1e5 m, " +
+                            std::string(names[c]) + ": expected a coordinate within +-1e5 m, " +
                                 "found " + quoted_snippet(tokens[c]));
     }
   }
   out_row->frame = static_cast<int64_t>(values[0]);
   out_row->id = static_cast<uint32_t>(values[1]);
-  out_row->position = glm::vec2(static_cast<float>(values[2]), static_cast<float>(values[3]));
+  out_row->position = glm::vec2(static_cast<float>(values[gx]), static_cast<float>(values[gy]));
   out_row->line = line;
   return Status::Ok();
 }
@@ -132,6 +155,7 @@ Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::
   rows.reserve(text.size() / 8 + 1);
   int line = 0;
   size_t pos = 0;
+  Layout layout{};  // set by the first row
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
@@ -140,12 +164,12 @@ Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::
     ++line;
     if (std::all_of(line_text.begin(), line_text.end(), is_space)) continue;  // blank line
     Row row{};
-    GK_RETURN_IF_ERROR(parse_row(line_text, file_name, line, &row));
+    GK_RETURN_IF_ERROR(parse_row(line_text, file_name, line, &layout, &row));
     rows.push_back(row);
   }
   if (rows.empty()) {
     return Status::AtLine(file_name, std::max(line, 1),
-                          "no trajectory rows: expected lines of 4 numbers (frame id x y)");
+                          std::string("no trajectory rows: ") + kLayouts + " per line");
   }
 
   std::sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {

@@ -1,5 +1,6 @@
 #pragma once
 // Private to crowd/: reading of ETH/UCY pedestrian trajectory text files ("frame id x y" per line,
+// or the 8 columns of ETH's obsmat.txt, "frame id pos_x pos_z pos_y v_x v_z v_y", every row alike;
 // tab or space separated) into per-pedestrian tracks, validated row by row.
 
 #include <cstdint>

@@ -1,6 +1,7 @@
 #pragma once
 // Replay of recorded pedestrian trajectories in the ETH/UCY text format (frame, id, x, y per line,
-// tab or space separated). Positions are resampled smoothly (C1: no velocity jumps) to the
+// tab or space separated; or the ETH authors' obsmat.txt, frame id pos_x pos_z pos_y v_x v_z v_y,
+// whose ground plane is (pos_x, pos_y)). Positions are resampled smoothly (C1: no velocity jumps) to the
 // simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
 // is ignored: the data is the truth.
 //

@@ -195,6 +195,68 @@ TEST(TrajectoryReplay, EthTimingCaveat) {
   std::cout << rel << ": replay median " << fast << " m/s at 0.4 s, " << slow << " at 0.667 s\n";
 }
 
+// The ETH authors' own annotations (obsmat.txt: frame ped pos_x pos_z pos_y v_x v_z v_y) replay
+// as they are. PROVENANCE.md: ETH's are annotated every 6 video frames, 0.4 s apart, with a median
+// speed of 1.47 m/s; hotel's are biwi_hotel.txt's rows with frame numbers one higher, the values
+// matching to about 0.05 m.
+std::vector<RawRow> read_raw_obsmat(const std::string& path) {
+  std::vector<RawRow> rows;
+  std::ifstream in(path);
+  double f, id, x, z, y, vx, vz, vy;
+  while (in >> f >> id >> x >> z >> y >> vx >> vz >> vy) {
+    rows.push_back({std::lround(f), std::lround(id), x, y});
+  }
+  return rows;
+}
+
+TEST(TrajectoryReplay, EthObsmatReplaysAtItsOwnTiming) {
+  const char* rel = "trajectories/eth/original/obsmat.txt";
+  GK_REQUIRE_DATA(rel);
+  const std::vector<RawRow> rows = read_raw_obsmat(test::data_path(rel));
+  ASSERT_EQ(rows.size(), 8908u);  // PROVENANCE.md
+  // Raw step speeds at 0.4 s per 6 frames (the helper counts kFramesPerSample frames per step).
+  const double raw = raw_median_step_speed(rows, 0.4 * kFramesPerSample / 6.0);
+  EXPECT_NEAR(raw, 1.47, 0.01);
+  auto replay = load(test::data_path(rel), 0.4f);
+  ASSERT_TRUE(replay);
+  EXPECT_EQ(replay->capacity(), 27u);  // PROVENANCE.md: at most 27 pedestrians on one frame
+  const double span = double(rows.back().frame - rows.front().frame) / 6.0 * 0.4;
+  const double s = replay_median_speeds(*replay, span).median_all;
+  EXPECT_NEAR(s, 1.47, 0.147);
+  std::cout << rel << ": raw median step speed " << raw << " m/s, replay median " << s << "\n";
+}
+
+TEST(TrajectoryReplay, HotelObsmatMatchesTheSocialGanRows) {
+  const char* obsmat = "trajectories/hotel/original/obsmat.txt";
+  const char* txt = "trajectories/hotel/biwi_hotel.txt";
+  GK_REQUIRE_DATA(obsmat);
+  GK_REQUIRE_DATA(txt);
+  auto a = load(test::data_path(obsmat), 0.4f);
+  auto b = load(test::data_path(txt), 0.4f);
+  ASSERT_TRUE(a && b);
+  // Both start at their first frame (obsmat's 1 is biwi_hotel's 0): step side by side.
+  std::vector<double> errors;
+  constexpr float kDt = 1.0f / 60.0f;
+  for (int f = 0; f < 60 * 120; ++f) {
+    ASSERT_TRUE(a->step(kDt).ok());
+    ASSERT_TRUE(b->step(kDt).ok());
+    const AgentFrame fa = a->frame(), fb = b->frame();
+    for (size_t i = 0; i < fa.size(); ++i) {
+      const auto it = std::find(fb.ids.begin(), fb.ids.end(), fa.ids[i]);
+      if (it == fb.ids.end()) continue;
+      errors.push_back(glm::length(fa.positions[i] - fb.positions[it - fb.ids.begin()]));
+    }
+  }
+  ASSERT_GT(errors.size(), 10000u);
+  const double med = median(errors);
+  std::sort(errors.begin(), errors.end());
+  const double p99 = errors[errors.size() * 99 / 100];
+  EXPECT_LT(med, 0.05);
+  EXPECT_LT(p99, 0.1);
+  std::cout << "hotel obsmat vs biwi_hotel.txt over 120 s: median " << med << " m, p99 " << p99
+            << " m over " << errors.size() << " agent-frames\n";
+}
+
 // Largest change of one agent's velocity between consecutive frames, over the first `span_s`.
 double max_velocity_change(CrowdSource& replay, float dt_s, double span_s) {
   std::map<uint32_t, glm::vec2> last;
@@ -254,7 +316,8 @@ TEST(TrajectoryReplay, MalformedFilesNameFileAndLine) {
     int line;
     const char* what;
   } kCases[] = {
-      {"wrong_column_count.txt", 2, "expected 4 numbers (frame id x y), found 3"},
+      {"wrong_column_count.txt", 2, "expected 4 numbers (frame id x y) or 8 (ETH obsmat"},
+      {"mixed_layouts.txt", 3, "expected 4 numbers as on the file's first row, found 8"},
       {"non_numeric.txt", 2, "column 3 (x): expected a number, found 'abc'"},
       {"nan_value.txt", 4, "column 3 (x): expected a finite number"},
       {"empty.txt", 1, "no trajectory rows"},
