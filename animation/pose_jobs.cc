@@ -683,6 +683,27 @@ void SkinningPaletteJob::run() const {
   }
 }
 
+void copy_matrices(std::span<const glm::mat4> from, std::span<glm::mat4> to, bool stream) {
+#if defined(__SSE2__)
+  if (stream && reinterpret_cast<uintptr_t>(to.data()) % 16 == 0) {
+    const float* a = &(*from.data())[0].x;
+    float* m = &(*to.data())[0].x;
+    const float* const a_end = a + 16 * from.size();
+    for (; a != a_end; a += 16, m += 16) {
+      const __m128 c0 = _mm_loadu_ps(a), c1 = _mm_loadu_ps(a + 4), c2 = _mm_loadu_ps(a + 8),
+                   c3 = _mm_loadu_ps(a + 12);
+      _mm_stream_ps(m, c0);
+      _mm_stream_ps(m + 4, c1);
+      _mm_stream_ps(m + 8, c2);
+      _mm_stream_ps(m + 12, c3);
+    }
+    return;
+  }
+#endif
+  (void)stream;
+  std::copy(from.begin(), from.end(), to.begin());
+}
+
 void stream_fence() {
 #if defined(__SSE2__)
   _mm_sfence();  // the streamed stores are ordered before whatever tells a reader they are done

@@ -127,6 +127,11 @@ struct SkinningPaletteJob {
   void run() const;
 };
 
+// Copies matrices (`to` at least as long as `from`); with `stream`, past the caches (streaming
+// stores when `to` is 16-byte aligned: a crowd's worth of them is read only after the crowd is
+// posed; stream_fence() orders them before telling anyone).
+void copy_matrices(std::span<const glm::mat4> from, std::span<glm::mat4> to, bool stream);
+
 // Orders the streamed stores of SkinningPaletteJobs run with fence off before what follows.
 void stream_fence();
 

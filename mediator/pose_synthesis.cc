@@ -24,6 +24,9 @@ struct PoseSynthesizer::Scratch {
   std::vector<glm::vec3> local_trans;
   std::vector<glm::quat> coarse_rot;    // the coarse joints' blended pose (pose_coarse)
   std::vector<glm::vec3> coarse_trans;
+  // The agent's world joints while it is posed (L1-resident throughout); kept in world_ once it
+  // is posed.
+  std::vector<glm::mat4> world;
 };
 
 namespace {
@@ -130,6 +133,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     s.local_trans.resize(J);
     s.coarse_rot.resize(K);
     s.coarse_trans.resize(K);
+    s.world.resize(J);
     return s;
   });
   subtree_end_ = subtree_ends(skeleton_);
@@ -197,6 +201,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   // A crowd's palettes far larger than the caches are written past them (read only by the
   // upload, after the whole crowd is posed); a small crowd's stay cached for it.
   stream_palettes_ = palette_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
+  stream_world_ = world_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
 }
 
 PoseSynthesizer::~PoseSynthesizer() = default;
@@ -224,9 +229,10 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
         synthesize_agent(pl, P, slot, dt_s, s, d == PoseDetail::kHold ? PoseDetail::kLight : d);
       }
     }
-    // The range's streamed palettes are ordered before the task's end tells anyone they are done
-    // (one fence here, not one per agent: each waits for the stores before it to reach memory).
-    if (stream_palettes_) stream_fence();
+    // The range's streamed palettes and world joints are ordered before the task's end tells
+    // anyone they are done (one fence here, not one per agent: each waits for the stores before
+    // it to reach memory).
+    if (stream_palettes_ || stream_world_) stream_fence();
   });
 }
 
@@ -250,7 +256,7 @@ void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot,
     prefetch_bytes(clip.frame_rotations(i0), rows * sizeof(glm::quat));  // frames i0 and i0 + 1
     prefetch_bytes(clip.frame_translations(i0), rows * sizeof(glm::vec3));
   }
-  prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
+  if (!stream_world_) prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
   if (coarse) return;
   prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
   // Far agents (kLight) keep no rotation history: max_rotation_change is for the pop metric, which
@@ -345,7 +351,7 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
   BlendPosesJob{{layers, static_cast<size_t>(num_samples)}, out_rot, out_trans}.run();
 }
 
-void PoseSynthesizer::fk(int slot, const glm::vec3* trans, int from, int to,
+void PoseSynthesizer::fk(int slot, glm::mat4* world, const glm::vec3* trans, int from, int to,
                          const glm::mat4& root) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
@@ -354,7 +360,7 @@ void PoseSynthesizer::fk(int slot, const glm::vec3* trans, int from, int to,
   job.rotations = {local_rot_.data() + base, J};
   job.translations = {trans, J};
   job.root_transform = root;
-  job.out_model = {world_.data() + base, J};
+  job.out_model = {world, J};
   job.from = from;
   job.to = to;
   job.run();
@@ -365,7 +371,7 @@ PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
   return {joint, subtree_end_[joint]};
 }
 
-void PoseSynthesizer::fk_list(int slot, const glm::vec3* trans,
+void PoseSynthesizer::fk_list(int slot, glm::mat4* world, const glm::vec3* trans,
                               const std::vector<int16_t>& joints, const glm::mat4& root) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
@@ -374,7 +380,7 @@ void PoseSynthesizer::fk_list(int slot, const glm::vec3* trans,
   job.rotations = {local_rot_.data() + base, J};
   job.translations = {trans, J};
   job.root_transform = &root;
-  job.out_model = {world_.data() + base, J};
+  job.out_model = {world, J};
   job.joints = joints;
   job.run();
 }
@@ -405,6 +411,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     pose_coarse(pl, P, slot, s);
     return;
   }
+  glm::mat4* world = s.world.data();  // kept in world_ once posed (finish_pose)
 
   // Sample and blend the planned layers.
   const glm::vec3* trans = s.local_trans.data();
@@ -419,25 +426,26 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool twisting = apm && detail != PoseDetail::kLight;
   if (twisting && can_twist_) {
     // The twist poses its whole range again: before it, only the joints it reads there.
-    fk_list(slot, trans, pre_twist_fk_, root);
+    fk_list(slot, world, trans, pre_twist_fk_, root);
   } else {
-    fk(slot, trans, 0, num_joints_, root);
+    fk(slot, world, trans, 0, num_joints_, root);
   }
   if (twisting) {
-    twist_spine(slot, trans, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
+    twist_spine(slot, world, trans, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
   }
   // Leaving full detail, the locks are let go through their releases (a reset would snap each
   // pinned foot to the clip's at once); once every foot is free the agent runs without them.
   const bool letting_go = apm && P.foot_locking && detail == PoseDetail::kNoFootLocks &&
                           !pl.fresh[slot] && locks_held(slot);
-  if (locking || letting_go) lock_feet(pl, P, slot, trans, root, dt, letting_go);
+  if (locking || letting_go) lock_feet(pl, P, slot, world, trans, root, dt, letting_go);
   // The twist measured the pelvis's heading, and nothing since moved the pelvis.
-  finish_pose(slot, detail, locking || letting_go, twisting && can_twist_ && pelvis_stays_);
+  finish_pose(slot, world, detail, locking || letting_go, twisting && can_twist_ && pelvis_stays_);
 }
 
 // What every posed agent ends with: headings, the rotation change, the drawn toes, the foot locks
-// reset when off, and the skinning palette.
-void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, bool pelvis_known) {
+// reset when off, the skinning palette, and its world joints (`world`, the thread's scratch) kept.
+void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, PoseDetail detail, bool locking,
+                                  bool pelvis_known) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   const bool track_rotation = detail != PoseDetail::kLight;
@@ -445,9 +453,9 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, boo
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (hips >= 0 && chest >= 0) {
     if (!pelvis_known) {
-      pelvis_heading_[slot] = joint_heading(world_[base + hips], rest_forward_[hips]);
+      pelvis_heading_[slot] = joint_heading(world[hips], rest_forward_[hips]);
     }
-    upper_heading_[slot] = joint_heading(world_[base + chest], rest_forward_[chest]);
+    upper_heading_[slot] = joint_heading(world[chest], rest_forward_[chest]);
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
@@ -465,7 +473,7 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, boo
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
   for (int side = 0; side < 2; ++side) {
     locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
-        translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+        translation_of(world[skeleton_.toe(static_cast<Side>(side))]);
   }
   if (!locking) {
     // Foot locks (and the pelvis drop and raised heels that serve them) start afresh from the
@@ -485,7 +493,7 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, boo
   has_prev_[slot] = 1;
   if (make_palettes_) {
     SkinningPaletteJob job;
-    job.model = {world_.data() + base, J};
+    job.model = {world, J};
     job.inverse_bind = inverse_bind_;
     job.out_palette = {palette_.data() + base, J};
     job.affine_inverse_bind = affine_inverse_bind_;
@@ -493,6 +501,9 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, boo
     job.fence = false;  // run() fences once per range of agents
     job.run();
   }
+  // The pose was made in the thread's scratch (its lines stay in L1 for the whole agent); a crowd's
+  // world joints far larger than the caches are streamed past them, like the palettes.
+  copy_matrices({world, J}, {world_.data() + base, J}, stream_world_);
 }
 
 // A far agent's pose (PoseDetail::kLight) on the coarse joints only (mediator/coarse_pose.h): the
@@ -500,7 +511,6 @@ void PoseSynthesizer::finish_pose(int slot, PoseDetail detail, bool locking, boo
 void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot,
                                   Scratch& s) {
   const size_t K = static_cast<size_t>(coarse_.num_coarse);
-  const size_t base = static_cast<size_t>(slot) * num_joints_;
   const std::span<glm::quat> rot(s.coarse_rot.data(), K);
   const std::span<glm::vec3> trans(s.coarse_trans.data(), K);
   sample_layers(pl, slot, /*coarse=*/true, s, rot.data(), trans.data(), K);
@@ -509,20 +519,20 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   root_offset_[slot] = glm::vec2(0.0f);
   const bool apm = P.mode == MediatorMode::kApm;
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
-  coarse_to_world(coarse_, skeleton_, rot, trans, root,
-                  {world_.data() + base, static_cast<size_t>(num_joints_)});
-  finish_pose(slot, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
+  glm::mat4* world = s.world.data();
+  coarse_to_world(coarse_, skeleton_, rot, trans, root, {world, static_cast<size_t>(num_joints_)});
+  finish_pose(slot, world, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
 }
 
-void PoseSynthesizer::twist_spine(int slot, const glm::vec3* trans, const glm::mat4& root,
-                                  float upper_yaw, float limit) {
+void PoseSynthesizer::twist_spine(int slot, glm::mat4* world, const glm::vec3* trans,
+                                  const glm::mat4& root, float upper_yaw, float limit) {
   const std::vector<int16_t>& chain = skeleton_.spine_chain;
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (chain.empty() || hips < 0 || chest < 0) return;
   const size_t base = static_cast<size_t>(slot) * num_joints_;
-  const float pelvis = joint_heading(world_[base + hips], rest_forward_[hips]);
+  const float pelvis = joint_heading(world[hips], rest_forward_[hips]);
   pelvis_heading_[slot] = pelvis;  // finish_pose's too when nothing moves the pelvis after
-  const float chest_now = joint_heading(world_[base + chest], rest_forward_[chest]);
+  const float chest_now = joint_heading(world[chest], rest_forward_[chest]);
   // The chest should face upper_yaw, but never further than the limit from the pelvis.
   // Unwrapped against last frame's torsion: theta passing behind the back must not flip the twist
   // from one limit to the other in a single frame.
@@ -537,13 +547,13 @@ void PoseSynthesizer::twist_spine(int slot, const glm::vec3* trans, const glm::m
   // inv(Q_j) * up, the world matrix's row y.
   const float c = std::cos(0.5f * per_joint), sn = std::sin(0.5f * per_joint);
   for (int16_t j : chain) {
-    const glm::mat4& m = world_[base + j];
+    const glm::mat4& m = world[j];
     const glm::vec3 up = glm::normalize(glm::vec3(m[0].y, m[1].y, m[2].y));
     const glm::quat corr(c, sn * up.x, sn * up.y, sn * up.z);
     local_rot_[base + j] = normalized_product(local_rot_[base + j], corr);
   }
   const JointRange r = subtree(chain.front());  // the chain lies in its first joint's subtree
-  fk(slot, trans, r.from, r.to, root);
+  fk(slot, world, trans, r.from, r.to, root);
 }
 
 bool PoseSynthesizer::locks_held(int slot) const {
@@ -555,8 +565,8 @@ bool PoseSynthesizer::locks_held(int slot) const {
 }
 
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
-                                const glm::vec3* trans, const glm::mat4& root, float dt,
-                                bool letting_go) {
+                                glm::mat4* world, const glm::vec3* trans,
+                                const glm::mat4& root, float dt, bool letting_go) {
   const size_t base = static_cast<size_t>(slot) * num_joints_;
   const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
                           library_.swing_height_m, library_.swing_speed_m_s, P.lock_release_s};
@@ -570,7 +580,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // Made whole in registers and stored once: a vector stored and then changed in memory is
     // read back (below) from two stores, which the load cannot take from the store buffer, and
     // it waits for every store before it (a streamed palette's too) to drain.
-    const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+    const glm::vec3 drawn = translation_of(world[skeleton_.toe(static_cast<Side>(side))]);
     const float lost = pl.gait_toe_y[side][slot] + root[3].y - drawn.y;
     const glm::vec3 toe(drawn.x,
                         drawn.y + std::max(0.0f, lost) * smoothstep01(2.0f * pl.gait_weight[slot]),
@@ -597,8 +607,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const Side other_side = static_cast<Side>(1 - side);
     const bool other_on_heel =
         other == FootLockState::kLocked && in.walking &&
-        on_heel(translation_of(world_[base + skeleton_.ankle(other_side)]),
-                translation_of(world_[base + skeleton_.toe(other_side)]),
+        on_heel(translation_of(world[skeleton_.ankle(other_side)]),
+                translation_of(world[skeleton_.toe(other_side)]),
                 library_.planted_ankle_m[1 - side], library_.planted_toe_m[1 - side]);
     in.other_landing = other_on_heel || other == FootLockState::kStepping ||
                        (pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&
@@ -618,9 +628,9 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   for (int side = 0; side < 2; ++side) {
     if (!pinned[side]) continue;
     const Side sd = static_cast<Side>(side);
-    const glm::vec3 ankle_goal = translation_of(world_[base + skeleton_.ankle(sd)]) + goal[side] -
-                                 translation_of(world_[base + skeleton_.toe(sd)]);
-    const glm::vec3 hip_p = translation_of(world_[base + skeleton_.hip(sd)]);
+    const glm::vec3 ankle_goal = translation_of(world[skeleton_.ankle(sd)]) + goal[side] -
+                                 translation_of(world[skeleton_.toe(sd)]);
+    const glm::vec3 hip_p = translation_of(world[skeleton_.hip(sd)]);
     const float reach = kDropReach * library_.leg_length_m[side];
     const float dx = ground_length(ankle_goal.x - hip_p.x, ankle_goal.z - hip_p.z);
     const float dy = hip_p.y - ankle_goal.y;
@@ -634,7 +644,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   placed[3].y -= drop;
   // Lowering the root lowers every joint by the same amount: no need for a second FK pass.
   if (drop != 0.0f) {
-    for (int j = 0; j < num_joints_; ++j) world_[base + j][3].y -= drop;
+    for (int j = 0; j < num_joints_; ++j) world[j][3].y -= drop;
   }
 
   glm::quat ankle_world_rot[2];
@@ -647,8 +657,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // Pinned feet stay where they are pinned, and free ones keep the clips' height over the floor
     // (the swing leg bends more): a lowered body never drags a swinging foot over the ground.
     glm::vec3 g = goal[side];
-    const glm::vec3 drawn_ankle = translation_of(world_[base + ankle]);
-    const glm::vec3 drawn_toe = translation_of(world_[base + skeleton_.toe(sd)]);
+    const glm::vec3 drawn_ankle = translation_of(world[ankle]);
+    const glm::vec3 drawn_toe = translation_of(world[skeleton_.toe(sd)]);
     // Never below the floor the clips were authored on: a toe below it is raised onto it, and an
     // ankle below its own floor lifts the heel about the ball (below, with the heel-off pivot).
     g.y = std::max(g.y, library_.planted_toe_m[side]);
@@ -656,7 +666,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     use_ik[side] = glm::dot(toe_offset[side], toe_offset[side]) > 1e-10f ||
                    drawn_ankle.y + toe_offset[side].y < library_.planted_ankle_m[side] ||
                    locks_.heel_pitch[static_cast<size_t>(slot) * 2 + side] > 0.0f;
-    if (use_ik[side]) ankle_world_rot[side] = rotation_of(world_[base + ankle]);
+    if (use_ik[side]) ankle_world_rot[side] = rotation_of(world[ankle]);
   }
   if (!use_ik[0] && !use_ik[1]) return;
   for (int side = 0; side < 2; ++side) {
@@ -665,9 +675,9 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const int hip = skeleton_.hip(sd), knee = skeleton_.knee(sd), ankle = skeleton_.ankle(sd);
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     // IK: move the ankle by the toe's offset, keep the foot's world orientation.
-    const glm::vec3 anim_ankle = translation_of(world_[base + ankle]);
+    const glm::vec3 anim_ankle = translation_of(world[ankle]);
     glm::vec3 goal_ankle = anim_ankle + toe_offset[side];
-    const glm::vec3 hip_p = translation_of(world_[base + hip]);
+    const glm::vec3 hip_p = translation_of(world[hip]);
     // The clip's own leg may be straighter than the limit (standing): only reaching further than
     // both counts.
     const float limit =
@@ -678,7 +688,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     float& pitch = locks_.heel_pitch[k];
     float& pitch_rate = locks_.heel_pitch_rate[k];
     if (pl.fresh[slot]) pitch = pitch_rate = 0.0f;
-    const glm::vec3 toe_goal = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
+    const glm::vec3 toe_goal = translation_of(world[skeleton_.toe(sd)]) + toe_offset[side];
     float reach_pitch = 0.0f, floor_pitch = 0.0f;
     glm::vec3 pitch_axis(0.0f);
     const glm::vec3 d = goal_ankle - toe_goal;
@@ -709,7 +719,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
         locks_.lock[k].state == FootLockState::kLocked) {
       // Overstretched even with the pelvis down and the heel up: the foot steps to where the clip
       // has it while the clip keeps it on the ground, and is let go when the clip lifts it.
-      const glm::vec3 drawn = translation_of(world_[base + skeleton_.toe(sd)]) + toe_offset[side];
+      const glm::vec3 drawn = translation_of(world[skeleton_.toe(sd)]) + toe_offset[side];
       const FootLockState other_state =
           locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
       if (!letting_go && pl.plant[side][slot] >= 0.5f && other_state == FootLockState::kLocked) {
@@ -726,15 +736,15 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                                            anim_vel[side]);
       }
     }
-    const glm::vec3 knee_p = translation_of(world_[base + knee]);
+    const glm::vec3 knee_p = translation_of(world[knee]);
     const glm::vec3 axis = glm::normalize(anim_ankle - hip_p);
     glm::vec3 pole = (knee_p - hip_p) - axis * glm::dot(knee_p - hip_p, axis);
     if (glm::length(pole) < 1e-4f) pole = glm::vec3(root[2]);
     glm::quat c_hip, c_knee;
     TwoBoneIKJob ik;
-    ik.start_model = world_[base + hip];
-    ik.mid_model = world_[base + knee];
-    ik.end_model = world_[base + ankle];
+    ik.start_model = world[hip];
+    ik.mid_model = world[knee];
+    ik.end_model = world[ankle];
     ik.target = goal_ankle;
     ik.pole = pole;
     ik.soften = kIkSoften;
@@ -746,7 +756,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     local_rot_[base + knee] = normalized_product(local_rot_[base + knee], c_knee);
   }
   const int ik_sides = (use_ik[0] ? 1 : 0) | (use_ik[1] ? 2 : 0);
-  fk_list(slot, trans, leg_fk_[ik_sides], placed);
+  fk_list(slot, world, trans, leg_fk_[ik_sides], placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet. A leg
   // without IK keeps its shin, ankle and foot as posed.
   for (int side = 0; side < 2; ++side) {
@@ -755,13 +765,13 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const int ankle = skeleton_.ankle(sd);
     const int parent = skeleton_.parents[ankle];
     if (parent < 0) continue;
-    const glm::quat parent_rot = rotation_of(world_[base + parent]);
+    const glm::quat parent_rot = rotation_of(world[parent]);
     local_rot_[base + ankle] = normalized_inverse_product(parent_rot, ankle_world_rot[side]);
   }
-  fk_list(slot, trans, foot_fk_[ik_sides], placed);
+  fk_list(slot, world, trans, foot_fk_[ik_sides], placed);
   for (int side = 0; side < 2; ++side) {
     if (!repin[side]) continue;
-    const glm::vec3 toe = translation_of(world_[base + skeleton_.toe(static_cast<Side>(side))]);
+    const glm::vec3 toe = translation_of(world[skeleton_.toe(static_cast<Side>(side))]);
     FootLock& lock = locks_.lock[static_cast<size_t>(slot) * 2 + side];
     lock.target.x = toe.x;
     lock.target.z = toe.z;

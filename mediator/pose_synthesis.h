@@ -105,10 +105,13 @@ class PoseSynthesizer {
   void sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
                      glm::quat* out_rot, glm::vec3* out_trans, size_t n);
   // pelvis_known: pelvis_heading_[slot] is already this pose's (twist_spine measured it).
-  void finish_pose(int slot, PoseDetail detail, bool locking, bool pelvis_known);
+  void finish_pose(int slot, const glm::mat4* world, PoseDetail detail, bool locking,
+                   bool pelvis_known);
   // Forward kinematics of joints [from, to) of a slot (their parents outside it are current);
-  // `trans`: the slot's local translations (the posing thread's scratch).
-  void fk(int slot, const glm::vec3* trans, int from, int to, const glm::mat4& root);
+  // `world`: the slot's world joints and `trans` its local translations (both in the posing
+  // thread's scratch).
+  void fk(int slot, glm::mat4* world, const glm::vec3* trans, int from, int to,
+          const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
   struct JointRange {
     int from = 0, to = 0;
@@ -116,16 +119,16 @@ class PoseSynthesizer {
   JointRange subtree(int joint) const;
   // Forward kinematics of a slot's joints in `joints`' order (LocalToModelListJob: runs of a few
   // joints each go four at a time across the runs, in one call).
-  void fk_list(int slot, const glm::vec3* trans, const std::vector<int16_t>& joints,
-               const glm::mat4& root);
+  void fk_list(int slot, glm::mat4* world, const glm::vec3* trans,
+               const std::vector<int16_t>& joints, const glm::mat4& root);
   // The joints of range a and then b (overlapping ranges as one), in order.
   std::vector<int16_t> range_list(JointRange a, JointRange b) const;
-  void twist_spine(int slot, const glm::vec3* trans, const glm::mat4& root, float upper_yaw,
-                   float limit_rad);
+  void twist_spine(int slot, glm::mat4* world, const glm::vec3* trans, const glm::mat4& root,
+                   float upper_yaw, float limit_rad);
   // Foot locks and leg IK. letting_go: the agent has left full detail, so no foot is pinned anew
   // (nor re-planted by a step); the locks it still has are let go as the clips lift each foot,
   // through the usual release, so nothing snaps.
-  void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
+  void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, glm::mat4* world,
                  const glm::vec3* trans, const glm::mat4& root, float dt, bool letting_go = false);
   // Any foot of the slot still pinned, stepping or shedding a release offset.
   bool locks_held(int slot) const;
@@ -171,6 +174,7 @@ class PoseSynthesizer {
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
   bool stream_palettes_ = false;
+  bool stream_world_ = false;  // world_ is written with streaming stores (copy_matrices)
 };
 
 // The heel-off pivot of leg IK (for tests): the foot's pitch about its toe [rad] that brings the
