@@ -24,9 +24,10 @@ struct PoseSynthesizer::Scratch {
   std::vector<glm::vec3> local_trans;
   std::vector<glm::quat> coarse_rot;    // the coarse joints' blended pose (pose_coarse)
   std::vector<glm::vec3> coarse_trans;
-  // The agent's world joints while it is posed (L1-resident throughout); kept in world_ once it
-  // is posed.
+  // The agent's world joints and local rotations while it is posed (L1-resident throughout);
+  // kept in world_ and local_rot_ once it is posed.
   std::vector<glm::mat4> world;
+  std::vector<glm::quat> local_rot;
 };
 
 namespace {
@@ -105,7 +106,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     for (size_t j = 0; j < J; ++j) inverse_bind_[j] = glm::inverse(rest[j]);
   }
   local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
-  prev_local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
   world_.assign(capacity * J, glm::mat4(1.0f));
   if (make_palettes_) palette_.assign(capacity * J, glm::mat4(1.0f));
   rot_change_.assign(capacity, 0.0f);
@@ -134,6 +134,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     s.coarse_rot.resize(K);
     s.coarse_trans.resize(K);
     s.world.resize(J);
+    s.local_rot.resize(J);
     return s;
   });
   subtree_end_ = subtree_ends(skeleton_);
@@ -259,10 +260,6 @@ void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot,
   if (!stream_world_) prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
   if (coarse) return;
   prefetch_bytes(local_rot_.data() + base, J * sizeof(glm::quat), true);
-  // Far agents (kLight) keep no rotation history: max_rotation_change is for the pop metric, which
-  // measures agents near the camera.
-  if (d != PoseDetail::kFull && d != PoseDetail::kNoFootLocks) return;
-  prefetch_bytes(prev_local_rot_.data() + base, J * sizeof(glm::quat), true);
   if (d != PoseDetail::kFull) return;
   prefetch_bytes(&locks_.lock[static_cast<size_t>(slot) * 2], 2 * sizeof(FootLock), true);
   prefetch_bytes(&locks_.anim_toe[static_cast<size_t>(slot) * 2], 2 * sizeof(glm::vec3), true);
@@ -351,13 +348,12 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
   BlendPosesJob{{layers, static_cast<size_t>(num_samples)}, out_rot, out_trans}.run();
 }
 
-void PoseSynthesizer::fk(int slot, glm::mat4* world, const glm::vec3* trans, int from, int to,
-                         const glm::mat4& root) {
+void PoseSynthesizer::fk(glm::mat4* world, const glm::quat* rot, const glm::vec3* trans, int from,
+                         int to, const glm::mat4& root) {
   const size_t J = num_joints_;
-  const size_t base = static_cast<size_t>(slot) * J;
   LocalToModelJob job;
   job.skeleton = &skeleton_;
-  job.rotations = {local_rot_.data() + base, J};
+  job.rotations = {rot, J};
   job.translations = {trans, J};
   job.root_transform = root;
   job.out_model = {world, J};
@@ -371,13 +367,12 @@ PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
   return {joint, subtree_end_[joint]};
 }
 
-void PoseSynthesizer::fk_list(int slot, glm::mat4* world, const glm::vec3* trans,
+void PoseSynthesizer::fk_list(glm::mat4* world, const glm::quat* rot, const glm::vec3* trans,
                               const std::vector<int16_t>& joints, const glm::mat4& root) {
   const size_t J = num_joints_;
-  const size_t base = static_cast<size_t>(slot) * J;
   LocalToModelListJob job;
   job.skeleton = &skeleton_;
-  job.rotations = {local_rot_.data() + base, J};
+  job.rotations = {rot, J};
   job.translations = {trans, J};
   job.root_transform = &root;
   job.out_model = {world, J};
@@ -401,7 +396,6 @@ std::vector<int16_t> PoseSynthesizer::range_list(JointRange a, JointRange b) con
 void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorParams& P, int slot,
                                        float dt, Scratch& s, PoseDetail detail) {
   const size_t J = num_joints_;
-  const size_t base = static_cast<size_t>(slot) * J;
   if (pl.fresh[slot]) {
     has_prev_[slot] = 0;
     drop_[slot] = 0.0f;  // nothing of the slot's previous agent carries over
@@ -411,11 +405,14 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
     pose_coarse(pl, P, slot, s);
     return;
   }
-  glm::mat4* world = s.world.data();  // kept in world_ once posed (finish_pose)
+  // The pose is made in the thread's scratch and kept in world_ and local_rot_ once made
+  // (finish_pose).
+  glm::mat4* world = s.world.data();
+  glm::quat* rot = s.local_rot.data();
 
   // Sample and blend the planned layers.
   const glm::vec3* trans = s.local_trans.data();
-  sample_layers(pl, slot, /*coarse=*/false, s, local_rot_.data() + base, s.local_trans.data(), J);
+  sample_layers(pl, slot, /*coarse=*/false, s, rot, s.local_trans.data(), J);
 
   const bool apm = P.mode == MediatorMode::kApm;
   const bool locking = apm && P.foot_locking && detail == PoseDetail::kFull;
@@ -426,26 +423,28 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   const bool twisting = apm && detail != PoseDetail::kLight;
   if (twisting && can_twist_) {
     // The twist poses its whole range again: before it, only the joints it reads there.
-    fk_list(slot, world, trans, pre_twist_fk_, root);
+    fk_list(world, rot, trans, pre_twist_fk_, root);
   } else {
-    fk(slot, world, trans, 0, num_joints_, root);
+    fk(world, rot, trans, 0, num_joints_, root);
   }
   if (twisting) {
-    twist_spine(slot, world, trans, root, pl.upper_yaw[slot], glm::radians(P.torsion_limit_deg));
+    twist_spine(slot, world, rot, trans, root, pl.upper_yaw[slot],
+                glm::radians(P.torsion_limit_deg));
   }
   // Leaving full detail, the locks are let go through their releases (a reset would snap each
   // pinned foot to the clip's at once); once every foot is free the agent runs without them.
   const bool letting_go = apm && P.foot_locking && detail == PoseDetail::kNoFootLocks &&
                           !pl.fresh[slot] && locks_held(slot);
-  if (locking || letting_go) lock_feet(pl, P, slot, world, trans, root, dt, letting_go);
+  if (locking || letting_go) lock_feet(pl, P, slot, world, rot, trans, root, dt, letting_go);
   // The twist measured the pelvis's heading, and nothing since moved the pelvis.
-  finish_pose(slot, world, detail, locking || letting_go, twisting && can_twist_ && pelvis_stays_);
+  finish_pose(slot, world, rot, detail, locking || letting_go,
+              twisting && can_twist_ && pelvis_stays_);
 }
 
 // What every posed agent ends with: headings, the rotation change, the drawn toes, the foot locks
 // reset when off, the skinning palette, and its world joints (`world`, the thread's scratch) kept.
-void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, PoseDetail detail, bool locking,
-                                  bool pelvis_known) {
+void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::quat* rot,
+                                  PoseDetail detail, bool locking, bool pelvis_known) {
   const size_t J = num_joints_;
   const size_t base = static_cast<size_t>(slot) * J;
   const bool track_rotation = detail != PoseDetail::kLight;
@@ -459,15 +458,15 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, PoseDetail d
     torsion_[slot] = wrap_pi(upper_heading_[slot] - pelvis_heading_[slot]);
   }
   float change = 0.0f;
-  bool kept = false;  // this pose's rotations are already kept as the previous ones
-  if (track_rotation && prev_rot_valid_[slot] && has_prev_[slot] && J > 1) {
-    // The largest angle is the acos of the smallest |dot| (acos falls): one acos per agent.
-    // Joint 0 carries the root facing, not a local bend. The rotations are kept for the next
-    // frame as they are read.
-    prev_local_rot_[base] = local_rot_[base];
-    change = 2.0f * std::acos(min_abs_dot_then_copy({local_rot_.data() + base + 1, J - 1},
-                                                    {prev_local_rot_.data() + base + 1, J - 1}));
-    kept = true;
+  if (rot && track_rotation && prev_rot_valid_[slot] && has_prev_[slot] && J > 1) {
+    // local_rot_ still holds the slot's last posed rotations. The largest angle is the acos of
+    // the smallest |dot| (acos falls): one acos per agent. Joint 0 carries the root facing, not a
+    // local bend. The new rotations replace the old as they are read.
+    local_rot_[base] = rot[0];
+    change = 2.0f * std::acos(min_abs_dot_then_copy({rot + 1, J - 1},
+                                                    {local_rot_.data() + base + 1, J - 1}));
+  } else if (rot) {
+    std::copy_n(rot, J, local_rot_.begin() + base);
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
@@ -485,9 +484,6 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, PoseDetail d
       locks_.anim_toe[k] = locks_.drawn_toe[k];
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
     }
-  }
-  if (track_rotation && !kept) {
-    std::copy_n(local_rot_.begin() + base, J, prev_local_rot_.begin() + base);
   }
   prev_rot_valid_[slot] = track_rotation;
   has_prev_[slot] = 1;
@@ -521,15 +517,15 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   glm::mat4* world = s.world.data();
   coarse_to_world(coarse_, skeleton_, rot, trans, root, {world, static_cast<size_t>(num_joints_)});
-  finish_pose(slot, world, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
+  finish_pose(slot, world, nullptr, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
 }
 
-void PoseSynthesizer::twist_spine(int slot, glm::mat4* world, const glm::vec3* trans,
-                                  const glm::mat4& root, float upper_yaw, float limit) {
+void PoseSynthesizer::twist_spine(int slot, glm::mat4* world, glm::quat* rot,
+                                  const glm::vec3* trans, const glm::mat4& root, float upper_yaw,
+                                  float limit) {
   const std::vector<int16_t>& chain = skeleton_.spine_chain;
   const int hips = skeleton_.role(JointRole::kHips), chest = skeleton_.role(JointRole::kChest);
   if (chain.empty() || hips < 0 || chest < 0) return;
-  const size_t base = static_cast<size_t>(slot) * num_joints_;
   const float pelvis = joint_heading(world[hips], rest_forward_[hips]);
   pelvis_heading_[slot] = pelvis;  // finish_pose's too when nothing moves the pelvis after
   const float chest_now = joint_heading(world[chest], rest_forward_[chest]);
@@ -550,10 +546,10 @@ void PoseSynthesizer::twist_spine(int slot, glm::mat4* world, const glm::vec3* t
     const glm::mat4& m = world[j];
     const glm::vec3 up = glm::normalize(glm::vec3(m[0].y, m[1].y, m[2].y));
     const glm::quat corr(c, sn * up.x, sn * up.y, sn * up.z);
-    local_rot_[base + j] = normalized_product(local_rot_[base + j], corr);
+    rot[j] = normalized_product(rot[j], corr);
   }
   const JointRange r = subtree(chain.front());  // the chain lies in its first joint's subtree
-  fk(slot, world, trans, r.from, r.to, root);
+  fk(world, rot, trans, r.from, r.to, root);
 }
 
 bool PoseSynthesizer::locks_held(int slot) const {
@@ -565,9 +561,8 @@ bool PoseSynthesizer::locks_held(int slot) const {
 }
 
 void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot,
-                                glm::mat4* world, const glm::vec3* trans,
+                                glm::mat4* world, glm::quat* rot, const glm::vec3* trans,
                                 const glm::mat4& root, float dt, bool letting_go) {
-  const size_t base = static_cast<size_t>(slot) * num_joints_;
   const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
                           library_.swing_height_m, library_.swing_speed_m_s, P.lock_release_s};
   glm::vec3 goal[2], anim_toe[2], anim_vel[2];
@@ -752,11 +747,11 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     ik.out_start_correction = &c_hip;
     ik.out_mid_correction = &c_knee;
     ik.run();
-    local_rot_[base + hip] = normalized_product(local_rot_[base + hip], c_hip);
-    local_rot_[base + knee] = normalized_product(local_rot_[base + knee], c_knee);
+    rot[hip] = normalized_product(rot[hip], c_hip);
+    rot[knee] = normalized_product(rot[knee], c_knee);
   }
   const int ik_sides = (use_ik[0] ? 1 : 0) | (use_ik[1] ? 2 : 0);
-  fk_list(slot, world, trans, leg_fk_[ik_sides], placed);
+  fk_list(world, rot, trans, leg_fk_[ik_sides], placed);
   // Restore each ankle's world orientation under its new shin, then finish the feet. A leg
   // without IK keeps its shin, ankle and foot as posed.
   for (int side = 0; side < 2; ++side) {
@@ -766,9 +761,9 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const int parent = skeleton_.parents[ankle];
     if (parent < 0) continue;
     const glm::quat parent_rot = rotation_of(world[parent]);
-    local_rot_[base + ankle] = normalized_inverse_product(parent_rot, ankle_world_rot[side]);
+    rot[ankle] = normalized_inverse_product(parent_rot, ankle_world_rot[side]);
   }
-  fk_list(slot, world, trans, foot_fk_[ik_sides], placed);
+  fk_list(world, rot, trans, foot_fk_[ik_sides], placed);
   for (int side = 0; side < 2; ++side) {
     if (!repin[side]) continue;
     const glm::vec3 toe = translation_of(world[skeleton_.toe(static_cast<Side>(side))]);

@@ -105,31 +105,32 @@ class PoseSynthesizer {
   void sample_layers(const AnimationPlans& pl, int slot, bool coarse, Scratch& s,
                      glm::quat* out_rot, glm::vec3* out_trans, size_t n);
   // pelvis_known: pelvis_heading_[slot] is already this pose's (twist_spine measured it).
-  void finish_pose(int slot, const glm::mat4* world, PoseDetail detail, bool locking,
-                   bool pelvis_known);
-  // Forward kinematics of joints [from, to) of a slot (their parents outside it are current);
-  // `world`: the slot's world joints and `trans` its local translations (both in the posing
-  // thread's scratch).
-  void fk(int slot, glm::mat4* world, const glm::vec3* trans, int from, int to,
+  // `rot`: the pose's local rotations (null for a coarse pose, which keeps none).
+  void finish_pose(int slot, const glm::mat4* world, const glm::quat* rot, PoseDetail detail,
+                   bool locking, bool pelvis_known);
+  // Forward kinematics of joints [from, to) of an agent (their parents outside it are current):
+  // its world joints, local rotations and translations, all in the posing thread's scratch.
+  void fk(glm::mat4* world, const glm::quat* rot, const glm::vec3* trans, int from, int to,
           const glm::mat4& root);
   // Joints [from, to) to recompute after some local transforms changed (empty: from == to).
   struct JointRange {
     int from = 0, to = 0;
   };
   JointRange subtree(int joint) const;
-  // Forward kinematics of a slot's joints in `joints`' order (LocalToModelListJob: runs of a few
-  // joints each go four at a time across the runs, in one call).
-  void fk_list(int slot, glm::mat4* world, const glm::vec3* trans,
+  // Forward kinematics of an agent's joints in `joints`' order (LocalToModelListJob: runs of a
+  // few joints each go four at a time across the runs, in one call).
+  void fk_list(glm::mat4* world, const glm::quat* rot, const glm::vec3* trans,
                const std::vector<int16_t>& joints, const glm::mat4& root);
   // The joints of range a and then b (overlapping ranges as one), in order.
   std::vector<int16_t> range_list(JointRange a, JointRange b) const;
-  void twist_spine(int slot, glm::mat4* world, const glm::vec3* trans, const glm::mat4& root,
-                   float upper_yaw, float limit_rad);
+  void twist_spine(int slot, glm::mat4* world, glm::quat* rot, const glm::vec3* trans,
+                   const glm::mat4& root, float upper_yaw, float limit_rad);
   // Foot locks and leg IK. letting_go: the agent has left full detail, so no foot is pinned anew
   // (nor re-planted by a step); the locks it still has are let go as the clips lift each foot,
   // through the usual release, so nothing snaps.
   void lock_feet(const AnimationPlans& pl, const MediatorParams& P, int slot, glm::mat4* world,
-                 const glm::vec3* trans, const glm::mat4& root, float dt, bool letting_go = false);
+                 glm::quat* rot, const glm::vec3* trans, const glm::mat4& root, float dt,
+                 bool letting_go = false);
   // Any foot of the slot still pinned, stepping or shedding a release offset.
   bool locks_held(int slot) const;
 
@@ -139,8 +140,7 @@ class PoseSynthesizer {
   bool make_palettes_;
   std::vector<glm::vec3> rest_forward_;  // per joint, +z of the rest pose in the joint's frame
   std::vector<glm::mat4> inverse_bind_;
-  std::vector<glm::quat> local_rot_;
-  std::vector<glm::quat> prev_local_rot_;
+  std::vector<glm::quat> local_rot_;  // the last posed rotations (max_rotation_change's reference)
   std::vector<glm::mat4> world_;
   std::vector<glm::mat4> palette_;
   std::vector<float> rot_change_;
@@ -148,7 +148,7 @@ class PoseSynthesizer {
   std::vector<float> pelvis_heading_;
   std::vector<float> upper_heading_;
   std::vector<uint8_t> has_prev_;
-  std::vector<uint8_t> prev_rot_valid_;  // prev_local_rot_ holds the slot's last posed rotations
+  std::vector<uint8_t> prev_rot_valid_;  // local_rot_ holds a pose to measure the change against
   std::vector<float> drop_;       // pelvis drop per slot [m]
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
