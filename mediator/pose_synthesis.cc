@@ -24,8 +24,8 @@ struct PoseSynthesizer::Scratch {
   std::vector<glm::vec3> local_trans;
   std::vector<glm::quat> coarse_rot;    // the coarse joints' blended pose (pose_coarse)
   std::vector<glm::vec3> coarse_trans;
-  // The agent's world joints and local rotations while it is posed (L1-resident throughout);
-  // kept in world_ and local_rot_ once it is posed.
+  // The agent's world joints (when world_ is streamed: world_of) and local rotations while it is
+  // posed (L1-resident throughout); kept in world_ and local_rot_ once it is posed.
   std::vector<glm::mat4> world;
   std::vector<glm::quat> local_rot;
 };
@@ -362,6 +362,14 @@ void PoseSynthesizer::fk(glm::mat4* world, const glm::quat* rot, const glm::vec3
   job.run();
 }
 
+// Where an agent's world joints are posed: a crowd's far larger than the caches in the thread's
+// scratch (its lines stay in L1 for the whole agent), then streamed past the caches into world_ as
+// the palettes are (finish_pose), rather than read for ownership line by line; a small crowd's
+// straight in world_, which stays cached.
+glm::mat4* PoseSynthesizer::world_of(int slot, Scratch& s) {
+  return stream_world_ ? s.world.data() : world_.data() + static_cast<size_t>(slot) * num_joints_;
+}
+
 PoseSynthesizer::JointRange PoseSynthesizer::subtree(int joint) const {
   if (joint < 0 || joint >= num_joints_) return {};
   return {joint, subtree_end_[joint]};
@@ -407,7 +415,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   }
   // The pose is made in the thread's scratch and kept in world_ and local_rot_ once made
   // (finish_pose).
-  glm::mat4* world = s.world.data();
+  glm::mat4* world = world_of(slot, s);
   glm::quat* rot = s.local_rot.data();
 
   // Sample and blend the planned layers.
@@ -442,7 +450,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
 }
 
 // What every posed agent ends with: headings, the rotation change, the drawn toes, the foot locks
-// reset when off, the skinning palette, and its world joints (`world`, the thread's scratch) kept.
+// reset when off, the skinning palette, and the local rotations and world joints kept (world_of).
 void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::quat* rot,
                                   PoseDetail detail, bool locking, bool pelvis_known) {
   const size_t J = num_joints_;
@@ -497,9 +505,7 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
     job.fence = false;  // run() fences once per range of agents
     job.run();
   }
-  // The pose was made in the thread's scratch (its lines stay in L1 for the whole agent); a crowd's
-  // world joints far larger than the caches are streamed past them, like the palettes.
-  copy_matrices({world, J}, {world_.data() + base, J}, stream_world_);
+  if (stream_world_) copy_matrices({world, J}, {world_.data() + base, J}, /*stream=*/true);
 }
 
 // A far agent's pose (PoseDetail::kLight) on the coarse joints only (mediator/coarse_pose.h): the
@@ -515,7 +521,7 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   root_offset_[slot] = glm::vec2(0.0f);
   const bool apm = P.mode == MediatorMode::kApm;
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
-  glm::mat4* world = s.world.data();
+  glm::mat4* world = world_of(slot, s);
   coarse_to_world(coarse_, skeleton_, rot, trans, root, {world, static_cast<size_t>(num_joints_)});
   finish_pose(slot, world, nullptr, PoseDetail::kLight, /*locking=*/false, /*pelvis_known=*/false);
 }

@@ -99,6 +99,7 @@ class PoseSynthesizer {
                         Scratch& s, PoseDetail detail = PoseDetail::kFull);
   void hold_agent(const AnimationPlans& pl, int slot);
   void prefetch_agent(const AnimationPlans& pl, int slot, std::span<const uint8_t> detail) const;
+  glm::mat4* world_of(int slot, Scratch& s);
   void pose_coarse(const AnimationPlans& pl, const MediatorParams& P, int slot, Scratch& s);
   // Pointers, not spans: a span passed on the stack is read back whole, which the store buffer
   // cannot forward from its two halves (the load then waits for the buffer to drain).
