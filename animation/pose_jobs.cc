@@ -639,10 +639,19 @@ void TwoBoneIKJob::run() const {
 }
 
 bool SkinningPaletteJob::validate() const {
-  return model.size() == inverse_bind.size() && out_palette.size() >= model.size();
+  return model.size() == inverse_bind.size() && out_palette.size() >= model.size() &&
+         (out_model_copy.empty() || out_model_copy.size() >= model.size());
 }
 
 void SkinningPaletteJob::run() const {
+#if defined(__SSE2__)
+  const bool fused_copy = !out_model_copy.empty() && affine_inverse_bind && stream_out &&
+                          reinterpret_cast<uintptr_t>(out_palette.data()) % 16 == 0 &&
+                          reinterpret_cast<uintptr_t>(out_model_copy.data()) % 16 == 0;
+#else
+  const bool fused_copy = false;
+#endif
+  if (!out_model_copy.empty() && !fused_copy) copy_matrices(model, out_model_copy, true);
   if (!affine_inverse_bind) {
     for (size_t j = 0; j < model.size(); ++j) out_palette[j] = model[j] * inverse_bind[j];
     return;
@@ -653,10 +662,18 @@ void SkinningPaletteJob::run() const {
     const float* a = &(*model.data())[0].x;
     const float* b = &(*inverse_bind.data())[0].x;
     float* m = &(*out_palette.data())[0].x;
+    float* copy = fused_copy ? &(*out_model_copy.data())[0].x : nullptr;
     const float* const a_end = a + 16 * model.size();
     for (; a != a_end; a += 16, b += 16, m += 16) {
       const __m128 a0 = _mm_loadu_ps(a), a1 = _mm_loadu_ps(a + 4), a2 = _mm_loadu_ps(a + 8),
                    a3 = _mm_loadu_ps(a + 12);
+      if (copy) {
+        _mm_stream_ps(copy, a0);
+        _mm_stream_ps(copy + 4, a1);
+        _mm_stream_ps(copy + 8, a2);
+        _mm_stream_ps(copy + 12, a3);
+        copy += 16;
+      }
       for (int c = 0; c < 4; ++c) {
         // The column loaded once, its entries broadcast from the register.
         const __m128 bc = _mm_loadu_ps(b + 4 * c);

@@ -123,6 +123,9 @@ struct SkinningPaletteJob {
   // Off, the caller fences once after many palettes (stream_fence()): a fence per palette waits
   // for each one's stores to reach memory.
   bool fence = true;
+  // Non-empty (model's size): the model matrices are also copied there, streamed as the palette
+  // is read from them (copy_matrices with stream on, in the same pass).
+  std::span<glm::mat4> out_model_copy;
   bool validate() const;
   void run() const;
 };

@@ -503,9 +503,11 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
     job.affine_inverse_bind = affine_inverse_bind_;
     job.stream_out = stream_palettes_;
     job.fence = false;  // run() fences once per range of agents
+    if (stream_world_) job.out_model_copy = {world_.data() + base, J};
     job.run();
+  } else if (stream_world_) {
+    copy_matrices({world, J}, {world_.data() + base, J}, /*stream=*/true);
   }
-  if (stream_world_) copy_matrices({world, J}, {world_.data() + base, J}, /*stream=*/true);
 }
 
 // A far agent's pose (PoseDetail::kLight) on the coarse joints only (mediator/coarse_pose.h): the

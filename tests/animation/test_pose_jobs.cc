@@ -544,6 +544,20 @@ TEST(SkinningPaletteJob, AffineProductEqualsTheFullOne) {
   std::vector<glm::mat4> streamed(n);
   SkinningPaletteJob{m, inv, streamed, true, true}.run();
   for (int i = 0; i < n; ++i) EXPECT_TRUE(same(full[i], streamed[i])) << s->names[i];
+  // The model matrices copied in the same pass (streamed, or not: not affine, not streamed).
+  for (const bool affine_path : {true, false}) {
+    for (const bool stream : {true, false}) {
+      std::vector<glm::mat4> pal(n), copy(n);
+      SkinningPaletteJob job{m, inv, pal, affine_path, stream};
+      job.out_model_copy = copy;
+      ASSERT_TRUE(job.validate());
+      job.run();
+      for (int i = 0; i < n; ++i) {
+        EXPECT_TRUE(same(full[i], pal[i])) << s->names[i];
+        EXPECT_TRUE(same(m[i], copy[i])) << s->names[i];
+      }
+    }
+  }
   inv[3][1][3] = 1e-7f;  // not affine any more
   EXPECT_FALSE(is_affine(inv));
 }
