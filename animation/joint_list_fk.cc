@@ -8,6 +8,7 @@
 #include <xmmintrin.h>
 #endif
 
+#include "animation/fk_compose.h"
 #include "animation/quat_sse.h"
 
 namespace gk {
@@ -51,20 +52,10 @@ void LocalToModelListJob::run() const {
       };
       const ptrdiff_t joint = j4[k];
       const ptrdiff_t parent = parents[joint];
-      const float* p = parent < 0 ? root : model + 16 * parent;
-      const __m128 p0 = _mm_loadu_ps(p), p1 = _mm_loadu_ps(p + 4), p2 = _mm_loadu_ps(p + 8),
-                   p3 = _mm_loadu_ps(p + 12);
-      auto column = [&](__m128 a, __m128 b, __m128 c) {
-        return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
-      };
       const float* t = t3 + 3 * joint;
-      float* m = model + 16 * joint;
-      _mm_storeu_ps(m, column(at(0), at(1), at(2)));
-      _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
-      _mm_storeu_ps(m + 8, column(at(6), at(7), at(8)));
-      _mm_storeu_ps(
-          m + 12,
-          _mm_add_ps(column(_mm_load1_ps(t), _mm_load1_ps(t + 1), _mm_load1_ps(t + 2)), p3));
+      const __m128 r[9] = {at(0), at(1), at(2), at(3), at(4), at(5), at(6), at(7), at(8)};
+      fk::compose(parent < 0 ? root : model + 16 * parent, r, _mm_load1_ps(t),
+                  _mm_load1_ps(t + 1), _mm_load1_ps(t + 2), model + 16 * joint);
     };
     compose(std::integral_constant<int, 0>{});
     if (n > 1) compose(std::integral_constant<int, 1>{});
@@ -83,14 +74,8 @@ void LocalToModelListJob::run() const {
   for (size_t i = 0; i < count; ++i) {
     const int joint = joints[i];
     const int parent = parents[joint];
-    const glm::mat4& p = parent < 0 ? *root_transform : out_model[parent];
-    const glm::mat3 r = glm::mat3_cast(rot[joint]);
-    const glm::vec3& t = trans[joint];
-    glm::mat4& m = out_model[joint];
-    m[0] = p[0] * r[0][0] + p[1] * r[0][1] + p[2] * r[0][2];
-    m[1] = p[0] * r[1][0] + p[1] * r[1][1] + p[2] * r[1][2];
-    m[2] = p[0] * r[2][0] + p[1] * r[2][1] + p[2] * r[2][2];
-    m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
+    fk::compose(parent < 0 ? *root_transform : out_model[parent], rot[joint], trans[joint],
+                out_model[joint]);
   }
   (void)model;
   (void)root;

@@ -13,6 +13,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtx/quaternion.hpp>
 
+#include "animation/fk_compose.h"
 #include "animation/quat_sse.h"
 
 namespace gk {
@@ -475,20 +476,10 @@ void LocalToModelJob::run() const {
       return broadcast_lane<f % 4>(t[f / 4]);
     };
     const int parent = parents[joint];
-    const float* p = parent < 0 ? root : model + 16 * parent;
-    const __m128 p0 = _mm_loadu_ps(p), p1 = _mm_loadu_ps(p + 4), p2 = _mm_loadu_ps(p + 8),
-                 p3 = _mm_loadu_ps(p + 12);
-    auto column = [&](__m128 a, __m128 b, __m128 c) {
-      return _mm_add_ps(_mm_add_ps(_mm_mul_ps(p0, a), _mm_mul_ps(p1, b)), _mm_mul_ps(p2, c));
-    };
-    float* m = model + 16 * joint;
-    _mm_storeu_ps(m, column(at(0), at(1), at(2)));
-    _mm_storeu_ps(m + 4, column(at(3), at(4), at(5)));
-    _mm_storeu_ps(m + 8, column(at(6), at(7), at(8)));
-    _mm_storeu_ps(m + 12, _mm_add_ps(column(tr(std::integral_constant<int, 0>{}),
-                                            tr(std::integral_constant<int, 1>{}),
-                                            tr(std::integral_constant<int, 2>{})),
-                                     p3));
+    const __m128 r[9] = {at(0), at(1), at(2), at(3), at(4), at(5), at(6), at(7), at(8)};
+    fk::compose(parent < 0 ? root : model + 16 * parent, r, tr(std::integral_constant<int, 0>{}),
+                tr(std::integral_constant<int, 1>{}), tr(std::integral_constant<int, 2>{}),
+                model + 16 * joint);
   };
   // The rotation matrices of the four joints from q4 on (their translations from t4, twelve
   // floats); the first `count` of them composed.
@@ -524,14 +515,8 @@ void LocalToModelJob::run() const {
 #endif
   for (; j < end; ++j) {
     const int parent = skeleton->parents[j];
-    const glm::mat4& p = parent < 0 ? root_transform : out_model[parent];
-    const glm::mat3 r = glm::mat3_cast(rotations[j]);
-    const glm::vec3& t = translations[j];
-    glm::mat4& m = out_model[j];
-    m[0] = p[0] * r[0][0] + p[1] * r[0][1] + p[2] * r[0][2];
-    m[1] = p[0] * r[1][0] + p[1] * r[1][1] + p[2] * r[1][2];
-    m[2] = p[0] * r[2][0] + p[1] * r[2][1] + p[2] * r[2][2];
-    m[3] = p[0] * t.x + p[1] * t.y + p[2] * t.z + p[3];
+    fk::compose(parent < 0 ? root_transform : out_model[parent], rotations[j], translations[j],
+                out_model[j]);
   }
 }
 
