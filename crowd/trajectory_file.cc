@@ -61,16 +61,15 @@ Status parse_number(std::string_view token, const char* column, const std::strin
   return Status::Ok();
 }
 
-// The two layouts a trajectory file may have (all of its rows alike): the common one of the
-// Social-LSTM/GAN releases, and the ETH (BIWI) authors' obsmat.txt, whose ground plane is
-// (pos_x, pos_y) and whose pos_z and velocity columns are not used (the replay derives velocity
-// from the positions).
-enum class Layout : uint8_t { kFrameIdXY = 4, kObsmat = 8 };
-
+// The two layouts a trajectory file may have, by their column count (all of a file's rows alike):
+// 4, the common one of the Social-LSTM/GAN releases; 8, the ETH (BIWI) authors' obsmat.txt, whose
+// ground plane is (pos_x, pos_y) and whose pos_z and velocity columns are not used (the replay
+// derives velocity from the positions).
 constexpr const char* kLayouts =
     "expected 4 numbers (frame id x y) or 8 (ETH obsmat: frame id pos_x pos_z pos_y v_x v_z v_y)";
 
-Status parse_row(std::string_view text, const std::string& file, int line, Layout* layout,
+// `columns`: the file's layout, 0 until its first row sets it.
+Status parse_row(std::string_view text, const std::string& file, int line, int* columns,
                  Row* out_row) {
   constexpr int kMaxTokens = 8;
   std::string_view tokens[kMaxTokens];
@@ -78,10 +77,10 @@ Status parse_row(std::string_view text, const std::string& file, int line, Layou
   if (count != 4 && count != 8) {
     return Status::AtLine(file, line, std::string(kLayouts) + ", found " + std::to_string(count));
   }
-  if (*layout == Layout{}) *layout = static_cast<Layout>(count);
-  if (count != static_cast<int>(*layout)) {
+  if (*columns == 0) *columns = count;
+  if (count != *columns) {
     return Status::AtLine(file, line,
-                          "expected " + std::to_string(static_cast<int>(*layout)) +
+                          "expected " + std::to_string(*columns) +
                               " numbers as on the file's first row, found " +
                               std::to_string(count));
   }
@@ -155,7 +154,7 @@ Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::
   rows.reserve(text.size() / 8 + 1);
   int line = 0;
   size_t pos = 0;
-  Layout layout{};  // set by the first row
+  int columns = 0;  // the file's layout (4 or 8), set by its first row
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
@@ -164,7 +163,7 @@ Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::
     ++line;
     if (std::all_of(line_text.begin(), line_text.end(), is_space)) continue;  // blank line
     Row row{};
-    GK_RETURN_IF_ERROR(parse_row(line_text, file_name, line, &layout, &row));
+    GK_RETURN_IF_ERROR(parse_row(line_text, file_name, line, &columns, &row));
     rows.push_back(row);
   }
   if (rows.empty()) {
