@@ -583,6 +583,26 @@ std::vector<std::string> describe_takes(const LocomotionLibrary& library) {
   return out;
 }
 
+void set_lift_phases(LocomotionClip* lc) {
+  const int nf = lc->clip.num_frames;
+  for (int s = 0; s < 2; ++s) {
+    lc->lift_phase[s] = -1.0f;
+    if (lc->swing_progress[s].size() != static_cast<size_t>(nf) || nf < 2) continue;
+    // The phase sample whose frame is earliest in a swing (the least progress above 0).
+    float least = 2.0f;
+    for (int k = 0; k < kPhaseTableSize; ++k) {
+      const float phase = static_cast<float>(k) / kPhaseTableSize;
+      int f = static_cast<int>(std::lround(lc->time_at_phase(phase) * lc->clip.fps));
+      f = lc->clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
+      const float progress = lc->swing_progress[s][f];
+      if (progress > 0.0f && progress < least) {
+        least = progress;
+        lc->lift_phase[s] = phase;
+      }
+    }
+  }
+}
+
 std::vector<std::string> gait_doubts(const LocomotionClip& lc) {
   std::vector<std::string> doubts;
   const ClipAnalysis& a = lc.analysis;
@@ -1293,6 +1313,9 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   for (const LocomotionClip& c : lib.clips) {
     lib.max_rotation_step_rad =
         std::max(lib.max_rotation_step_rad, max_rotation_step(c.clip, sk.num_joints()));
+  }
+  for (LocomotionClip& c : lib.clips) {
+    if (c.gait) set_lift_phases(&c);
   }
   return lib;
 }

@@ -48,6 +48,9 @@ struct LocomotionClip {
   // How far through its swing each foot is, 0 where it leaves the ground to 1 where it lands
   // (0 while planted).
   std::vector<float> swing_progress[2];
+  // The gait phase at which each foot leaves the ground (its swing's first frame; -1: it never
+  // swings). A standing agent sets off there: its first step is a whole swing.
+  float lift_phase[2] = {-1.0f, -1.0f};
   float toe_floor_m[2] = {0.0f, 0.0f};    // lowest toe height in the clip
   float ankle_floor_m[2] = {0.0f, 0.0f};  // lowest ankle height in the clip
   // Why this gait clip's contact analysis is doubtful (empty when it is sound): contacts that do
@@ -170,6 +173,8 @@ bool gait_analysis_doubtful(const LocomotionLibrary& library);
 // Why a gait clip's analysis is doubtful (see LocomotionClip::doubts); empty when it is sound.
 // Needs the clip's analysis and phase table.
 std::vector<std::string> gait_doubts(const LocomotionClip& clip);
+// Sets clip->lift_phase from its phase table and swing progress (a gait clip's).
+void set_lift_phases(LocomotionClip* clip);
 
 // One line per segmented take: its segments (kind and span), the clips cut from it, and its
 // problems.

@@ -322,6 +322,30 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       }
     }
     float rate = 1.0f;
+    if (gait_w > 0.0f && out_gait_weight[slot] <= 0.0f && !c.fresh[slot] &&
+        P.mode == MediatorMode::kApm) {
+      // Setting off from standing (the gait clips were out of the blend, so their phase was not
+      // seen): from where a foot of the heaviest gait clip leaves the ground, so the first step
+      // is a whole swing that lifts the foot, not the end of one that slides it in.
+      int heaviest = -1;
+      for (int k = 0; k < kMaxBlendLayers; ++k) {
+        if (lib.clips[lc[k]].gait && lw[k] > 0.0f && (heaviest < 0 || lw[k] > lw[heaviest])) {
+          heaviest = k;
+        }
+      }
+      const float* lift = lib.clips[lc[heaviest]].lift_phase;
+      float best = -1.0f, best_ahead = 2.0f;
+      for (int s = 0; s < 2; ++s) {
+        if (lift[s] < 0.0f) continue;
+        float ahead = lift[s] - phase[slot];
+        ahead -= std::floor(ahead);
+        if (ahead < best_ahead) {
+          best_ahead = ahead;
+          best = lift[s];
+        }
+      }
+      if (best >= 0.0f) phase[slot] = best;
+    }
     if (gait_w > 0.0f) {
       if (P.mode == MediatorMode::kNaive) {
         rate = 1.0f;

@@ -123,6 +123,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.heel_pitch.assign(capacity * 2, 0.0f);
   locks_.heel_pitch_rate.assign(capacity * 2, 0.0f);
+  locks_.lift_share.assign(capacity * 2, 0.0f);
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   coarse_ = make_coarse_rig(library);
   const size_t K = static_cast<size_t>(coarse_.num_coarse);
@@ -491,6 +492,7 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
       locks_.lock[k] = FootLock();
       locks_.anim_toe[k] = locks_.drawn_toe[k];
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
+      locks_.lift_share[k] = 0.0f;
     }
   }
   prev_rot_valid_[slot] = track_rotation;
@@ -577,17 +579,28 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   bool pinned[2] = {false, false};
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
-    // The clip's toe, no lower than the gait clips alone have it (a walk blended with a standing
-    // pose swings lower); the more the blend stands, the less of that height is given back, so
-    // it fades in and out with the blend.
+    // The clip's toe, no lower than the gait clips alone have it: a walk blended with a standing
+    // pose (a slow walk) takes shorter steps, but a foot that steps still clears the ground as
+    // the walk does. While the other foot is pinned and carries the weight, the height the blend
+    // takes away is given back in full once the gait clips step the feet (they vote the
+    // contacts from kGaitVoteWeight), fading in below that. Otherwise (both feet free: a start,
+    // a re-plant, a clip whose trailing toe leaves early) only as much as the blend walks, so the
+    // body never hangs on two lifted feet. The share moves toward its goal over the lock's
+    // release time, so the toe never jumps.
     // Made whole in registers and stored once: a vector stored and then changed in memory is
     // read back (below) from two stores, which the load cannot take from the store buffer, and
     // it waits for every store before it (a streamed palette's too) to drain.
     const glm::vec3 drawn = translation_of(world[skeleton_.toe(static_cast<Side>(side))]);
     const float lost = pl.gait_toe_y[side][slot] + root[3].y - drawn.y;
-    const glm::vec3 toe(drawn.x,
-                        drawn.y + std::max(0.0f, lost) * smoothstep01(2.0f * pl.gait_weight[slot]),
-                        drawn.z);
+    const bool other_carries =
+        locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
+    const float gw = pl.gait_weight[slot];
+    const float share_goal =
+        smoothstep01(other_carries ? gw / kGaitVoteWeight : 2.0f * gw);
+    float& share = locks_.lift_share[k];
+    share = pl.fresh[slot] ? share_goal
+                           : approach(share, share_goal, dt / std::max(P.lock_release_s, dt));
+    const glm::vec3 toe(drawn.x, drawn.y + std::max(0.0f, lost) * share, drawn.z);
     anim_toe[side] = toe;
     FootLockInput in;
     in.anim_toe = toe;

@@ -36,6 +36,9 @@ struct FootLocks {
   std::vector<glm::vec3> drawn_toe;    // the toe as drawn last frame (after IK) [m]
   std::vector<float> heel_pitch;       // heel raised about the ball by the pivot [rad]
   std::vector<float> heel_pitch_rate;  // its rate [rad/s] (it settles back on a spring)
+  // Share of the swing height a standing blend takes away that is given back to this foot, 0..1
+  // (it moves toward its goal over MediatorParams::lock_release_s, so the toe never jumps).
+  std::vector<float> lift_share;
 };
 
 class PoseSynthesizer {

@@ -2,6 +2,7 @@
 // Critically damped springs (exact integration, stable for any dt): the simulator's velocity and
 // torso orientation are filtered through them so zig-zag never reaches the body.
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -48,6 +49,11 @@ inline float wrap_pi(float a) {
     if (a < 0.0f) a += 2.0f * kPi;
   }
   return a - kPi;
+}
+
+// Moves a toward b by at most max_step.
+inline float approach(float a, float b, float max_step) {
+  return a + std::clamp(b - a, -max_step, max_step);
 }
 
 // Moves angle a toward b by at most max_step (shortest way round).
