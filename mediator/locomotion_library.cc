@@ -327,8 +327,16 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     for (const auto& [first, len] : swing_runs(lc->plant[s], c.loops)) {
       for (int k = 0; k < len; ++k) lc->swing_progress[s][(first + k) % n] = (k + 0.5f) / len;
     }
+    // While the other foot is down too (double support), a ball still as low as in contact keeps
+    // its weight however fast the clip moves it: a foot on the floor does not slide, it pushes off
+    // until it lifts (a keyframed trailing toe that sweeps forward along the floor as the lead heel
+    // lands is lifted later, in the air, by the release).
+    const std::vector<uint8_t> other_down =
+        contact_frames(lc->analysis, 1 - s, n, c.fps, false);
     for (int f = 0; f < n; ++f) {
-      lc->hold[s][f] = lc->plant[s][f] || (lc->toe_height_m[s][f] <= max_h && speed[f] <= max_v);
+      const bool low = lc->toe_height_m[s][f] <= max_h;
+      lc->hold[s][f] =
+          lc->plant[s][f] || (low && (speed[f] <= max_v || other_down[f] != 0));
     }
   }
 }
