@@ -36,6 +36,10 @@ struct AnimationPlans {
   // blended with a standing pose swings lower, and pose synthesis gives a foot that is not pinned
   // the gait clips' own swing height back.
   std::vector<float> gait_toe_y[2];
+  // The voting clips' own ball speed over the ground at this frame's rate [m/s] (< 0: not known):
+  // a foot has landed once its ball rests in the clips, though a blend's changing weights may
+  // still move the drawn foot.
+  std::vector<float> clip_toe_speed[2];
   std::vector<float> gait_weight;        // share of gait clips (not standing) in the blend, 0..1
   std::vector<float> swing_progress[2];  // blended swing progress of each foot, 0..1
   std::vector<float> double_support;     // share of the voting clips that walk (0..1)

@@ -113,11 +113,16 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
     case FootLockState::kReleasing: {
       // The clips plant the foot while its ball may still roll down and forward off the heel
       // (and a blend of clips lands a foot over a few frames): it is pinned once the ball has come
-      // to rest over the ground, or has stopped slowing down, where it was drawn last frame; and
+      // to rest over the ground, or has stopped slowing down, where it was drawn last frame (or
+      // rests in the clips themselves, the blend's changing weights still carrying it on no faster
+      // than the body travels: a landed foot, not a swing to finish); and
       // at once if the other foot is not pinned: off the ground, it leaves this one the weight,
       // and a foot that carries the weight does not move over the ground.
-      const bool at_rest =
-          in.fresh || speed <= in.still_speed_m_s || (last_speed >= 0.0f && speed >= last_speed);
+      const bool clip_at_rest = in.clip_speed_m_s >= 0.0f &&
+                                in.clip_speed_m_s <= in.still_speed_m_s &&
+                                speed <= 2.0f * in.still_speed_m_s;
+      const bool at_rest = in.fresh || speed <= in.still_speed_m_s || clip_at_rest ||
+                           (last_speed >= 0.0f && speed >= last_speed);
       const bool carries_weight = !in.other_locked;
       if (in.plant && (at_rest || carries_weight)) plant(s, in);
       return;

@@ -277,6 +277,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
       speed[f] = std::hypot(vel.x, vel.z);
       lc->toe_height_m[s][f] = toe[s][f].y - min_t;
     }
+    lc->toe_speed_m_s[s] = speed;
     // A lock pins the ball: it may start only where the ball itself has come to rest (slower
     // than half the travel speed, as contact analysis judges a planted point), not while the heel
     // strikes or the foot rolls off its tip with the ball still moving: each contact's ends are
@@ -450,6 +451,7 @@ LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
     idle.plant[s].assign(2, 1);
     idle.hold[s].assign(2, 1);
     idle.toe_height_m[s].assign(2, 0.0f);
+    idle.toe_speed_m_s[s].assign(2, 0.0f);
   }
   return idle;
 }
@@ -511,6 +513,7 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
     }
     lc.plant[s].assign(n, 0);
     lc.hold[s].assign(n, 0);
+    lc.toe_speed_m_s[s] = ground;
     std::vector<float> rested;
     for (int f = 0; f < n; ++f) {
       const float rest = still_speed_m_s((*speed)[f], ct);

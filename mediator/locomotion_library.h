@@ -42,6 +42,9 @@ struct LocomotionClip {
   std::vector<uint8_t> plant[2];
   std::vector<uint8_t> hold[2];
   std::vector<float> toe_height_m[2];  // toe height above its lowest point
+  // The ball's speed over the ground per frame at native rate (the clip's own: a blend's weights
+  // moving the drawn foot are not in it) [m/s]; empty where not known.
+  std::vector<float> toe_speed_m_s[2];
   // Both feet are in contact on some frame (a walk; a run has a flight phase instead): a foot then
   // keeps its weight until the other has taken it over.
   bool double_support = false;

@@ -41,6 +41,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
     plans_.plant[s].assign(capacity, 1.0f);
     plans_.hold[s].assign(capacity, 1.0f);
     plans_.gait_toe_y[s].assign(capacity, 0.0f);
+    plans_.clip_toe_speed[s].assign(capacity, -1.0f);
     plans_.swing_progress[s].assign(capacity, 0.0f);
     plans_.double_support.assign(capacity, 0.0f);
   }
@@ -257,11 +258,12 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
       {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_min_cadence_, tr_lag_,
        tr_prev_speed_, tr_prev_phase_, tr_still_, tr_moving_, tr_counts_});
   contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, tr_time_,
-                pl.gait_weight, pl.layer_time_s,
+                pl.gait_weight, pl.playback_rate, pl.layer_time_s,
                 {{pl.plant[0], pl.plant[1]},
                  {pl.hold[0], pl.hold[1]},
                  {pl.swing_progress[0], pl.swing_progress[1]},
                  {pl.gait_toe_y[0], pl.gait_toe_y[1]},
+                 {pl.clip_toe_speed[0], pl.clip_toe_speed[1]},
                  pl.double_support});
   feedback_pass(
       crowd, honoured, sim_pos_, sim_vel_, sim_theta_, fed_speed_, pl.lower_yaw, pl.standing,

@@ -620,8 +620,8 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
 void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                    std::span<const float> layer_weight, std::span<const float> phase,
                    std::span<const float> idle_time_s, std::span<const float> transition_time_s,
-                   std::span<const float> gait_weight, std::span<float> out_layer_time_s,
-                   ContactPlans out) {
+                   std::span<const float> gait_weight, std::span<const float> playback_rate,
+                   std::span<float> out_layer_time_s, ContactPlans out) {
   const LocomotionLibrary& lib = c.library;
   for_each_agent(c, [&](size_t, int slot) {
     const int16_t* lc = &layer_clip[slot * kMaxBlendLayers];
@@ -634,6 +634,8 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     // swings.
     float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
     float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, walk = 0.0f;
+    float toe_speed[2] = {0.0f, 0.0f}, speed_w[2] = {0.0f, 0.0f};
+    const float rate = playback_rate[slot];
     float moving_w = gait_w;  // gait clips and a transition: they vote without the standing clip
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       if (lib.clips[lc[k]].transition) moving_w += lw[k];
@@ -674,6 +676,11 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
           swing[s] += lw[k] * (b >= a ? a + fu * (b - a) : sp[f]);
         }
         hold[s] += lw[k] * clip.hold[s][f];
+        if (!clip.toe_speed_m_s[s].empty()) {
+          // A gait clip runs at the playback rate; a transition's own clock is near it.
+          toe_speed[s] += lw[k] * clip.toe_speed_m_s[s][f] * (clip.gait ? rate : 1.0f);
+          speed_w[s] += lw[k];
+        }
       }
     }
     for (int s = 0; s < 2; ++s) {
@@ -681,6 +688,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       out.hold[s][slot] = hold[s] / std::max(vote_w, 1e-6f);
       out.swing_progress[s][slot] = swing[s] / std::max(vote_w, 1e-6f);
       out.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : 0.0f;
+      out.clip_toe_speed[s][slot] = speed_w[s] > 0.0f ? toe_speed[s] / speed_w[s] : -1.0f;
     }
     out.double_support[slot] = walk / std::max(vote_w, 1e-6f);
   });

@@ -238,6 +238,7 @@ struct ContactPlans {
   std::span<float> hold[2];            // "keep the lock", 0..1
   std::span<float> swing_progress[2];  // 0 at lift-off, 1 at landing
   std::span<float> gait_toe_y[2];      // the gait clips' own toe height [m]
+  std::span<float> clip_toe_speed[2];  // the voting clips' own ball speed [m/s] (< 0: unknown)
   std::span<float> double_support;     // share of the voting clips that walk, 0..1
 };
 // Reads the layers, the phase, the standing clip's and the transition's clocks and the share of
@@ -247,8 +248,8 @@ struct ContactPlans {
 void contacts_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
                    std::span<const float> layer_weight, std::span<const float> phase,
                    std::span<const float> idle_time_s, std::span<const float> transition_time_s,
-                   std::span<const float> gait_weight, std::span<float> out_layer_time_s,
-                   ContactPlans out);
+                   std::span<const float> gait_weight, std::span<const float> playback_rate,
+                   std::span<float> out_layer_time_s, ContactPlans out);
 
 // --- feedback -----------------------------------------------------------------------------------
 // Per agent, index-aligned with the frame.

@@ -631,6 +631,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                         other_coming_down);
     in.floor_toe_m = library_.planted_toe_m[side];
     in.still_speed_m_s = still_speed_m_s(pl.speed_m_s[slot]);
+    in.clip_speed_m_s = pl.clip_toe_speed[side][slot];
     goal[side] = advance_foot_lock(locks_.lock[k], in, lp, dt);
     anim_vel[side] = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
 

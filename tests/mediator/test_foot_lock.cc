@@ -120,6 +120,65 @@ TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
   EXPECT_EQ(locked_at, 3);
 }
 
+// A ball at rest in the clips has landed, though the blend's changing weights (a walk fading in
+// over a standing pose as an agent speeds up) still carry the drawn foot slowly on, slowing all
+// the while: it is pinned at once rather than glided along the floor until the weights settle;
+// but not a foot still moving faster over the ground than the body travels (twice the still
+// speed), whose stop would be a jolt; and not without the clips' own ball speed.
+TEST(FootLock, BallAtRestInTheClipsIsPinnedThoughTheBlendStillMovesIt) {
+  const float still = 0.2f;  // [m/s] half the body's travel speed
+  for (float clip_speed : {0.05f, -1.0f}) {
+    Foot foot;
+    foot.step({0.0f, 0.04f, 0.0f}, false, false, 0.9f, true, still);
+    float x = 0.0f;
+    int locked_at = -1;
+    // Slowing 0.39, 0.38, ... m/s: above the still speed, never "no slower than before".
+    for (int i = 0; i < 8; ++i) {
+      x += (0.39f - 0.01f * i) * kDt;
+      FootLockInput in;
+      in.anim_toe = {x, kFloor, 0.0f};
+      in.anim_toe_prev = foot.anim;
+      in.drawn_toe_prev = foot.goal;
+      in.plant = in.hold = true;
+      in.other_locked = true;
+      in.floor_toe_m = kFloor;
+      in.still_speed_m_s = still;
+      in.clip_speed_m_s = clip_speed;
+      foot.anim = in.anim_toe;
+      const FootLockStep next = step_foot_lock(foot.lock, in, foot.params, kDt);
+      foot.lock = next.state;
+      foot.goal = next.goal;
+      if (locked_at < 0 && foot.lock.state == FootLockState::kLocked) locked_at = i;
+    }
+    if (clip_speed >= 0.0f) {
+      EXPECT_EQ(locked_at, 0);
+    } else {
+      EXPECT_EQ(locked_at, -1) << "without the clips' speed the glide is the ball's own";
+    }
+  }
+  // Faster than the body travels (a swing's last frames as the blend changes clips): not pinned.
+  Foot fast;
+  fast.step({0.0f, 0.04f, 0.0f}, false, false, 0.9f, true, still);
+  float x = 0.0f;
+  for (int i = 0; i < 4; ++i) {
+    x += (1.5f - 0.2f * i) * kDt;
+    FootLockInput in;
+    in.anim_toe = {x, kFloor, 0.0f};
+    in.anim_toe_prev = fast.anim;
+    in.drawn_toe_prev = fast.goal;
+    in.plant = in.hold = true;
+    in.other_locked = true;
+    in.floor_toe_m = kFloor;
+    in.still_speed_m_s = still;
+    in.clip_speed_m_s = 0.0f;
+    fast.anim = in.anim_toe;
+    const FootLockStep next = step_foot_lock(fast.lock, in, fast.params, kDt);
+    fast.lock = next.state;
+    fast.goal = next.goal;
+    EXPECT_NE(fast.lock.state, FootLockState::kLocked) << i;
+  }
+}
+
 // Walking, a trailing foot whose clip lifts it while the leading foot is still coming down keeps
 // its lock until the leading one is pinned; then it is let go.
 TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
