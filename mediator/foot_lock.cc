@@ -115,7 +115,7 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
       // (and a blend of clips lands a foot over a few frames): it is pinned once the ball has come
       // to rest over the ground, or has stopped slowing down, where it was drawn last frame (or
       // rests in the clips themselves, the blend's changing weights still carrying it on no faster
-      // than the body travels: a landed foot, not a swing to finish); and
+      // than twice the still speed, about the body's: a landed foot, not a swing to finish); and
       // at once if the other foot is not pinned: off the ground, it leaves this one the weight,
       // and a foot that carries the weight does not move over the ground.
       const bool clip_at_rest = in.clip_speed_m_s >= 0.0f &&

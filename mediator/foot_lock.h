@@ -14,8 +14,8 @@
 // other foot is pinned, with a short step as high as the clips' own swing.
 //
 //   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest (or
-//                             rests in the clips, no faster than the body travels), or the
-//                             other foot is not pinned (this one takes the weight)
+//                             rests in the clips, moving no faster than twice the still speed),
+//                             or the other foot is not pinned (this one takes the weight)
 //   kReleasing -> kLocked     plant_foot: planted again before the offset was shed
 //   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing);
 //                             it sets off from rest (its rest carried on and shed)
@@ -89,8 +89,9 @@ struct FootLockInput {
   float still_speed_m_s = 0.0f;
   // The clips' own ball speed over the ground [m/s] (< 0: not known). A ball at rest in the clips
   // has landed, though the drawn foot may still move with a blend's changing weights: it is
-  // pinned then, if no faster over the ground than the body travels (twice still_speed_m_s),
-  // not carried along the floor until the weights settle.
+  // pinned then, if no faster over the ground than twice still_speed_m_s (the body's own speed,
+  // or the still speed's capture-jitter floor's double for a slow body), not carried along the
+  // floor until the weights settle.
   float clip_speed_m_s = -1.0f;
 };
 

@@ -239,13 +239,14 @@ float stance_sweep_speed(const LocomotionClip& lc, const Skeleton& sk) {
 }
 
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
-  {
-    // A walk has double support: both feet in contact on some frame (a run has a flight instead).
-    const int nf = lc->clip.num_frames;
-    const std::vector<uint8_t> l = contact_frames(lc->analysis, 0, nf, lc->clip.fps, false);
-    const std::vector<uint8_t> r = contact_frames(lc->analysis, 1, nf, lc->clip.fps, false);
-    lc->double_support = false;
-    for (int f = 0; f < nf; ++f) lc->double_support = lc->double_support || (l[f] && r[f]);
+  // Each foot's contacts as clip analysis finds them.
+  const std::vector<uint8_t> down[2] = {
+      contact_frames(lc->analysis, 0, lc->clip.num_frames, lc->clip.fps, false),
+      contact_frames(lc->analysis, 1, lc->clip.num_frames, lc->clip.fps, false)};
+  // A walk has double support: both feet in contact on some frame (a run has a flight instead).
+  lc->double_support = false;
+  for (int f = 0; f < lc->clip.num_frames; ++f) {
+    lc->double_support = lc->double_support || (down[0][f] && down[1][f]);
   }
   const Clip& c = lc->clip;
   const int n = c.num_frames;
@@ -265,7 +266,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     lc->toe_floor_m[s] = min_t;
     lc->ankle_floor_m[s] = min_a;
     // A lock may start where clip analysis has the foot in contact.
-    lc->plant[s] = contact_frames(lc->analysis, s, n, c.fps, false);
+    lc->plant[s] = down[s];
     // It is kept while the ball of the foot still bears weight: no higher above the ground, and
     // no faster over it, than it ever is in this clip's own contacts (the heel may rise: the foot
     // pivots on the ball at heel-off).
@@ -278,6 +279,8 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
       lc->toe_height_m[s][f] = toe[s][f].y - min_t;
     }
     lc->toe_speed_m_s[s] = speed;
+    // Across a loop's wrap the speed above is the travel speed: the frame before's is nearer.
+    if (c.loops && n > 1) lc->toe_speed_m_s[s][n - 1] = speed[n - 2];
     // A lock pins the ball: it may start only where the ball itself has come to rest (slower
     // than half the travel speed, as contact analysis judges a planted point), not while the heel
     // strikes or the foot rolls off its tip with the ball still moving: each contact's ends are
@@ -332,12 +335,10 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     // its weight however fast the clip moves it: a foot on the floor does not slide, it pushes off
     // until it lifts (a keyframed trailing toe that sweeps forward along the floor as the lead heel
     // lands is lifted later, in the air, by the release).
-    const std::vector<uint8_t> other_down =
-        contact_frames(lc->analysis, 1 - s, n, c.fps, false);
     for (int f = 0; f < n; ++f) {
       const bool low = lc->toe_height_m[s][f] <= max_h;
       lc->hold[s][f] =
-          lc->plant[s][f] || (low && (speed[f] <= max_v || other_down[f] != 0));
+          lc->plant[s][f] || (low && (speed[f] <= max_v || down[1 - s][f] != 0));
     }
   }
 }
@@ -505,6 +506,7 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
   const ContactThresholds ct;
   for (int s = 0; s < 2; ++s) {
     const std::vector<uint8_t> contact = contact_frames(lc.analysis, s, n, lc.clip.fps, false);
+    const std::vector<uint8_t> other = contact_frames(lc.analysis, 1 - s, n, lc.clip.fps, false);
     std::vector<float> ground(n, 0.0f);
     for (int f = 0; f < n; ++f) {
       const int a = std::max(0, f - 1), b = std::min(n - 1, f + 1);
@@ -521,8 +523,10 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
       if (lc.plant[s][f]) rested.push_back(ground[f]);
     }
     const float max_v = rested.empty() ? 0.0f : percentile(std::move(rested), 0.9);
+    // As in a gait clip, a ball in contact while the other foot is down too pushes off, however
+    // fast the take moves it, until it leaves the ground.
     for (int f = 0; f < n; ++f) {
-      lc.hold[s][f] = lc.plant[s][f] || (contact[f] && ground[f] <= max_v);
+      lc.hold[s][f] = lc.plant[s][f] || (contact[f] && (ground[f] <= max_v || other[f]));
     }
     lc.toe_height_m[s].assign(n, 0.0f);
     float min_t = 1e9f, min_a = 1e9f;
@@ -598,6 +602,8 @@ void set_lift_phases(LocomotionClip* lc) {
   const int nf = lc->clip.num_frames;
   for (int s = 0; s < 2; ++s) {
     lc->lift_phase[s] = -1.0f;
+    // Doubtful contacts (no foot lock is planted on them) give no lift to set off from either.
+    if (!lc->doubts.empty()) continue;
     if (lc->swing_progress[s].size() != static_cast<size_t>(nf) || nf < 2) continue;
     // The phase sample whose frame is earliest in a swing (the least progress above 0).
     float least = 2.0f;

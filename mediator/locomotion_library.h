@@ -176,7 +176,8 @@ bool gait_analysis_doubtful(const LocomotionLibrary& library);
 // Why a gait clip's analysis is doubtful (see LocomotionClip::doubts); empty when it is sound.
 // Needs the clip's analysis and phase table.
 std::vector<std::string> gait_doubts(const LocomotionClip& clip);
-// Sets clip->lift_phase from its phase table and swing progress (a gait clip's).
+// Sets clip->lift_phase from its phase table and swing progress (a gait clip's; -1 for a clip
+// whose contacts are doubtful).
 void set_lift_phases(LocomotionClip* clip);
 
 // One line per segmented take: its segments (kind and span), the clips cut from it, and its

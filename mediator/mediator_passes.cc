@@ -299,6 +299,7 @@ GaitFrequency gait_frequency(const LocomotionLibrary& lib, const int16_t* lc, co
 void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
                      std::span<const float> cadence_scale, std::span<const float> lower_yaw,
+                     std::span<const float> transition_weight,
                      std::span<float> phase, std::span<float> idle_time_s,
                      std::span<float> out_playback_rate, std::span<float> out_gait_weight,
                      std::span<float> out_travel_yaw) {
@@ -322,11 +323,12 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       }
     }
     float rate = 1.0f;
-    if (gait_w > 0.0f && out_gait_weight[slot] <= 0.0f && !c.fresh[slot] &&
-        P.mode == MediatorMode::kApm) {
+    if (gait_w > 0.0f && out_gait_weight[slot] <= 0.0f && !(transition_weight[slot] > 0.0f) &&
+        !c.fresh[slot] && is_apm(c)) {
       // Setting off from standing (the gait clips were out of the blend, so their phase was not
       // seen): from where a foot of the heaviest gait clip leaves the ground, so the first step
-      // is a whole swing that lifts the foot, not the end of one that slides it in.
+      // is a whole swing that lifts the foot, not the end of one that slides it in. (A start or
+      // stop clip drives the phase itself while it plays.)
       int heaviest = -1;
       for (int k = 0; k < kMaxBlendLayers; ++k) {
         if (lib.clips[lc[k]].gait && lw[k] > 0.0f && (heaviest < 0 || lw[k] > lw[heaviest])) {
@@ -621,7 +623,8 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                    std::span<const float> layer_weight, std::span<const float> phase,
                    std::span<const float> idle_time_s, std::span<const float> transition_time_s,
                    std::span<const float> gait_weight, std::span<const float> playback_rate,
-                   std::span<float> out_layer_time_s, ContactPlans out) {
+                   std::span<const float> transition_rate, std::span<float> out_layer_time_s,
+                   ContactPlans out) {
   const LocomotionLibrary& lib = c.library;
   for_each_agent(c, [&](size_t, int slot) {
     const int16_t* lc = &layer_clip[slot * kMaxBlendLayers];
@@ -635,7 +638,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
     float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, walk = 0.0f;
     float toe_speed[2] = {0.0f, 0.0f}, speed_w[2] = {0.0f, 0.0f};
-    const float rate = playback_rate[slot];
+    const float rate = playback_rate[slot], tr_rate = transition_rate[slot];
     float moving_w = gait_w;  // gait clips and a transition: they vote without the standing clip
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       if (lib.clips[lc[k]].transition) moving_w += lw[k];
@@ -677,8 +680,9 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
         }
         hold[s] += lw[k] * clip.hold[s][f];
         if (!clip.toe_speed_m_s[s].empty()) {
-          // A gait clip runs at the playback rate; a transition's own clock is near it.
-          toe_speed[s] += lw[k] * clip.toe_speed_m_s[s][f] * (clip.gait ? rate : 1.0f);
+          // A gait clip runs at the playback rate, a transition at its own clock's.
+          const float r = clip.transition ? tr_rate : clip.gait ? rate : 1.0f;
+          toe_speed[s] += lw[k] * clip.toe_speed_m_s[s][f] * r;
           speed_w[s] += lw[k];
         }
       }

@@ -175,9 +175,12 @@ void weights_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
 // the playback rate (speed over the blend's native speed, within the rate limits; 1 without gait
 // clips), the gait phase (advanced by the blend's cycle frequency times the rate), the standing
 // clip's clock, the share of gait clips and the travel direction the played clips imply [rad].
+// An agent setting off from standing (no gait clip in last frame's blend, no transition playing:
+// `transition_weight` is last frame's) starts its gait phase where a foot leaves the ground.
 void rate_phase_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
                      std::span<const float> cadence_scale, std::span<const float> lower_yaw,
+                     std::span<const float> transition_weight,
                      std::span<float> phase, std::span<float> idle_time_s,
                      std::span<float> out_playback_rate, std::span<float> out_gait_weight,
                      std::span<float> out_travel_yaw);
@@ -241,15 +244,17 @@ struct ContactPlans {
   std::span<float> clip_toe_speed[2];  // the voting clips' own ball speed [m/s] (< 0: unknown)
   std::span<float> double_support;     // share of the voting clips that walk, 0..1
 };
-// Reads the layers, the phase, the standing clip's and the transition's clocks and the share of
-// gait clips. Writes each layer's clip time (phase-synchronised: a new clip starts in phase) and
-// the feet's contacts, voted by the gait clips (and a transition) alone once they carry a quarter
-// of the blend.
+// Reads the layers, the phase, the standing clip's and the transition's clocks, the share of
+// gait clips and the playback rates (the gait clips' and the transition's). Writes each layer's
+// clip time (phase-synchronised: a new clip starts in phase) and the feet's contacts, voted by the
+// gait clips (and a transition) alone once they carry a quarter of the blend, with the voting
+// clips' own ball speed at those rates.
 void contacts_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
                    std::span<const float> layer_weight, std::span<const float> phase,
                    std::span<const float> idle_time_s, std::span<const float> transition_time_s,
                    std::span<const float> gait_weight, std::span<const float> playback_rate,
-                   std::span<float> out_layer_time_s, ContactPlans out);
+                   std::span<const float> transition_rate, std::span<float> out_layer_time_s,
+                   ContactPlans out);
 
 // --- feedback -----------------------------------------------------------------------------------
 // Per agent, index-aligned with the frame.

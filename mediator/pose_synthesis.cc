@@ -593,6 +593,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::vec3 drawn = translation_of(world[skeleton_.toe(static_cast<Side>(side))]);
     const float lost = pl.gait_toe_y[side][slot] + root[3].y - drawn.y;
     const bool other_carries =
+        !letting_go &&
         locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
     const float gw = pl.gait_weight[slot];
     const float share_goal =
