@@ -30,7 +30,7 @@ struct Foot {
   glm::vec3 goal{0.0f}, anim{0.0f};
   bool started = false;
   glm::vec3 step(const glm::vec3& anim_toe, bool plant, bool hold, float progress = 0.0f,
-                 bool other_locked = false, float still_speed = 0.0f) {
+                 bool other_locked = false, float still_speed = 0.0f, float clip_speed = -1.0f) {
     FootLockInput in;
     in.anim_toe = anim_toe;
     in.anim_toe_prev = started ? anim : anim_toe;
@@ -42,6 +42,7 @@ struct Foot {
     in.other_locked = other_locked;
     in.floor_toe_m = kFloor;
     in.still_speed_m_s = still_speed;
+    in.clip_speed_m_s = clip_speed;
     started = true;
     anim = anim_toe;
     const FootLockStep next = step_foot_lock(lock, in, params, kDt);
@@ -136,19 +137,7 @@ TEST(FootLock, BallAtRestInTheClipsIsPinnedThoughTheBlendStillMovesIt) {
     // Slowing 0.36, 0.35, ... m/s: above the still speed, never "no slower than before".
     for (int i = 0; i < 8; ++i) {
       x += (0.36f - 0.01f * i) * kDt;
-      FootLockInput in;
-      in.anim_toe = {x, kFloor, 0.0f};
-      in.anim_toe_prev = foot.anim;
-      in.drawn_toe_prev = foot.goal;
-      in.plant = in.hold = true;
-      in.other_locked = true;
-      in.floor_toe_m = kFloor;
-      in.still_speed_m_s = still;
-      in.clip_speed_m_s = clip_speed;
-      foot.anim = in.anim_toe;
-      const FootLockStep next = step_foot_lock(foot.lock, in, foot.params, kDt);
-      foot.lock = next.state;
-      foot.goal = next.goal;
+      foot.step({x, kFloor, 0.0f}, true, true, 0.0f, true, still, clip_speed);
       if (locked_at < 0 && foot.lock.state == FootLockState::kLocked) locked_at = i;
     }
     if (clip_speed >= 0.0f && clip_speed <= still) {
@@ -164,19 +153,7 @@ TEST(FootLock, BallAtRestInTheClipsIsPinnedThoughTheBlendStillMovesIt) {
   float x = 0.0f;
   for (int i = 0; i < 4; ++i) {
     x += (1.5f - 0.2f * i) * kDt;
-    FootLockInput in;
-    in.anim_toe = {x, kFloor, 0.0f};
-    in.anim_toe_prev = fast.anim;
-    in.drawn_toe_prev = fast.goal;
-    in.plant = in.hold = true;
-    in.other_locked = true;
-    in.floor_toe_m = kFloor;
-    in.still_speed_m_s = still;
-    in.clip_speed_m_s = 0.0f;
-    fast.anim = in.anim_toe;
-    const FootLockStep next = step_foot_lock(fast.lock, in, fast.params, kDt);
-    fast.lock = next.state;
-    fast.goal = next.goal;
+    fast.step({x, kFloor, 0.0f}, true, true, 0.0f, true, still, 0.0f);
     EXPECT_NE(fast.lock.state, FootLockState::kLocked) << i;
   }
 }
