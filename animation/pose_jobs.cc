@@ -649,25 +649,43 @@ void SkinningPaletteJob::run() const {
     float* m = &(*out_palette.data())[0].x;
     float* copy = fused_copy ? &(*out_model_copy.data())[0].x : nullptr;
     const float* const a_end = a + 16 * model.size();
-    for (; a != a_end; a += 16, b += 16, m += 16) {
-      const __m128 a0 = _mm_loadu_ps(a), a1 = _mm_loadu_ps(a + 4), a2 = _mm_loadu_ps(a + 8),
-                   a3 = _mm_loadu_ps(a + 12);
-      if (copy) {
-        _mm_stream_ps(copy, a0);
-        _mm_stream_ps(copy + 4, a1);
-        _mm_stream_ps(copy + 8, a2);
-        _mm_stream_ps(copy + 12, a3);
-        copy += 16;
+    // One loop per case, with the copy or without, for any affine inverse binds or translations
+    // only (the tests hoisted out of the joints' loop).
+    auto palettes = [&](auto with_copy, auto translations) __attribute__((always_inline)) {
+      for (; a != a_end; a += 16, b += 16, m += 16) {
+        const __m128 a0 = _mm_loadu_ps(a), a1 = _mm_loadu_ps(a + 4), a2 = _mm_loadu_ps(a + 8),
+                     a3 = _mm_loadu_ps(a + 12);
+        if constexpr (decltype(with_copy)::value) {
+          _mm_stream_ps(copy, a0);
+          _mm_stream_ps(copy + 4, a1);
+          _mm_stream_ps(copy + 8, a2);
+          _mm_stream_ps(copy + 12, a3);
+          copy += 16;
+        }
+        if constexpr (decltype(translations)::value) {
+          _mm_stream_ps(m, a0);
+          _mm_stream_ps(m + 4, a1);
+          _mm_stream_ps(m + 8, a2);
+        }
+        for (int c = decltype(translations)::value ? 3 : 0; c < 4; ++c) {
+          // The column loaded once, its entries broadcast from the register.
+          const __m128 bc = _mm_loadu_ps(b + 4 * c);
+          __m128 col = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, broadcast_lane<0>(bc)),
+                                             _mm_mul_ps(a1, broadcast_lane<1>(bc))),
+                                  _mm_mul_ps(a2, broadcast_lane<2>(bc)));
+          if (c == 3) col = _mm_add_ps(col, a3);
+          _mm_stream_ps(m + 4 * c, col);
+        }
       }
-      for (int c = 0; c < 4; ++c) {
-        // The column loaded once, its entries broadcast from the register.
-        const __m128 bc = _mm_loadu_ps(b + 4 * c);
-        __m128 col = _mm_add_ps(_mm_add_ps(_mm_mul_ps(a0, broadcast_lane<0>(bc)),
-                                           _mm_mul_ps(a1, broadcast_lane<1>(bc))),
-                                _mm_mul_ps(a2, broadcast_lane<2>(bc)));
-        if (c == 3) col = _mm_add_ps(col, a3);
-        _mm_stream_ps(m + 4 * c, col);
-      }
+    };
+    if (copy && translation_inverse_bind) {
+      palettes(std::true_type{}, std::true_type{});
+    } else if (copy) {
+      palettes(std::true_type{}, std::false_type{});
+    } else if (translation_inverse_bind) {
+      palettes(std::false_type{}, std::true_type{});
+    } else {
+      palettes(std::false_type{}, std::false_type{});
     }
     if (fence) stream_fence();
     return;
@@ -678,9 +696,15 @@ void SkinningPaletteJob::run() const {
     const glm::mat4& a = model[j];
     const glm::mat4& b = inverse_bind[j];
     glm::mat4& m = out_palette[j];
-    m[0] = a[0] * b[0][0] + a[1] * b[0][1] + a[2] * b[0][2];
-    m[1] = a[0] * b[1][0] + a[1] * b[1][1] + a[2] * b[1][2];
-    m[2] = a[0] * b[2][0] + a[1] * b[2][1] + a[2] * b[2][2];
+    if (translation_inverse_bind) {
+      m[0] = a[0];
+      m[1] = a[1];
+      m[2] = a[2];
+    } else {
+      m[0] = a[0] * b[0][0] + a[1] * b[0][1] + a[2] * b[0][2];
+      m[1] = a[0] * b[1][0] + a[1] * b[1][1] + a[2] * b[1][2];
+      m[2] = a[0] * b[2][0] + a[1] * b[2][1] + a[2] * b[2][2];
+    }
     m[3] = a[0] * b[3][0] + a[1] * b[3][1] + a[2] * b[3][2] + a[3];
   }
 }
@@ -742,9 +766,18 @@ float min_abs_dot_then_copy(std::span<const glm::quat> a, std::span<glm::quat> b
     const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
     __m128 m = _mm_set1_ps(1.0f);
     for (; j + 4 <= n; j += 4) {
-      const Quat4 qa = load4(a.data() + j);
-      m = _mm_min_ps(_mm_and_ps(dot4(qa, load4(b.data() + j)), abs_mask), m);
-      for (size_t k = 0; k < 4; ++k) b[j + k] = a[j + k];
+      // a's four quaternions copied from the registers they are loaded into, before the transpose.
+      const float* pa = &a[j].x;
+      float* pb = &b[j].x;
+      __m128 ax = _mm_loadu_ps(pa), ay = _mm_loadu_ps(pa + 4), az = _mm_loadu_ps(pa + 8),
+             aw = _mm_loadu_ps(pa + 12);
+      const Quat4 qb = load4(b.data() + j);
+      _mm_storeu_ps(pb, ax);
+      _mm_storeu_ps(pb + 4, ay);
+      _mm_storeu_ps(pb + 8, az);
+      _mm_storeu_ps(pb + 12, aw);
+      _MM_TRANSPOSE4_PS(ax, ay, az, aw);
+      m = _mm_min_ps(_mm_and_ps(dot4(Quat4{ax, ay, az, aw}, qb), abs_mask), m);
     }
     alignas(16) float lanes[4];
     _mm_store_ps(lanes, m);
@@ -756,6 +789,18 @@ float min_abs_dot_then_copy(std::span<const glm::quat> a, std::span<glm::quat> b
     b[j] = a[j];
   }
   return d_min;
+}
+
+bool is_translation(std::span<const glm::mat4> matrices) {
+  if (!is_affine(matrices)) return false;
+  for (const glm::mat4& m : matrices) {
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) {
+        if (m[c][r] != (c == r ? 1.0f : 0.0f)) return false;
+      }
+    }
+  }
+  return true;
 }
 
 bool is_affine(std::span<const glm::mat4> matrices) {

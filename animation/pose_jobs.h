@@ -126,6 +126,11 @@ struct SkinningPaletteJob {
   // Non-empty (model's size): the model matrices are also copied there, streamed as the palette
   // is read from them (copy_matrices with stream on, in the same pass).
   std::span<glm::mat4> out_model_copy;
+  // With affine_inverse_bind: every inverse bind is a translation (its 3x3 exactly the identity,
+  // as a rig whose rest rotations are all the identity has, a BVH's): the palette's first three
+  // columns are the model matrix's own (the product's but for the sign of a zero: x * 1 + y * 0
+  // + z * 0 is x), and only the last is computed. is_translation(inverse_bind) tells which.
+  bool translation_inverse_bind = false;
   bool validate() const;
   void run() const;
 };
@@ -148,6 +153,8 @@ float min_abs_dot_then_copy(std::span<const glm::quat> a, std::span<glm::quat> b
 
 // True when every matrix's bottom row is exactly 0 0 0 1.
 bool is_affine(std::span<const glm::mat4> matrices);
+// True when every matrix is affine and its 3x3 exactly the identity (a translation).
+bool is_translation(std::span<const glm::mat4> matrices);
 
 // Asks the caches for the lines of [p, p + bytes) ahead of use (a hint; no effect on results).
 inline void prefetch_bytes(const void* p, size_t bytes, bool for_write = false) {

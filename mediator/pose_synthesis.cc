@@ -200,6 +200,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     }
   }
   affine_inverse_bind_ = is_affine(inverse_bind_);
+  translation_inverse_bind_ = is_translation(inverse_bind_);
   // A crowd's palettes far larger than the caches are written past them (read only by the
   // upload, after the whole crowd is posed); a small crowd's stay cached for it.
   stream_palettes_ = palette_.size() * sizeof(glm::mat4) > (size_t{8} << 20);
@@ -503,6 +504,7 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
     job.inverse_bind = inverse_bind_;
     job.out_palette = {palette_.data() + base, J};
     job.affine_inverse_bind = affine_inverse_bind_;
+    job.translation_inverse_bind = translation_inverse_bind_;
     job.stream_out = stream_palettes_;
     job.fence = false;  // run() fences once per range of agents
     if (stream_world_) job.out_model_copy = {world_.data() + base, J};

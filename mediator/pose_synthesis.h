@@ -177,6 +177,7 @@ class PoseSynthesizer {
   std::vector<int16_t> leg_fk_[4], foot_fk_[4];
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
   bool affine_inverse_bind_ = false;
+  bool translation_inverse_bind_ = false;  // is_translation(inverse_bind_): the cheaper palette
   bool stream_palettes_ = false;
   bool stream_world_ = false;  // world_ is written with streaming stores (copy_matrices)
 };

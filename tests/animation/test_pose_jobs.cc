@@ -558,6 +558,28 @@ TEST(SkinningPaletteJob, AffineProductEqualsTheFullOne) {
       }
     }
   }
+  // The humanoid's rest rotations are the identity: its inverse binds are translations, and the
+  // palette's first three columns the model's own (equal to the product's, -0 == 0).
+  ASSERT_TRUE(is_translation(inv));
+  for (const bool stream : {true, false}) {
+    for (const bool with_copy : {true, false}) {
+      std::vector<glm::mat4> pal(n), copy(n);
+      SkinningPaletteJob job{m, inv, pal, true, stream};
+      if (with_copy) job.out_model_copy = copy;
+      job.translation_inverse_bind = true;
+      ASSERT_TRUE(job.validate());
+      job.run();
+      for (int i = 0; i < n; ++i) {
+        EXPECT_TRUE(same(full[i], pal[i])) << s->names[i];
+        if (with_copy) {
+          EXPECT_TRUE(same(m[i], copy[i])) << s->names[i];
+        }
+      }
+    }
+  }
+  inv[2][0][1] = 1e-7f;  // a rotation: not a translation, still affine
+  EXPECT_FALSE(is_translation(inv));
+  EXPECT_TRUE(is_affine(inv));
   inv[3][1][3] = 1e-7f;  // not affine any more
   EXPECT_FALSE(is_affine(inv));
 }
