@@ -170,10 +170,24 @@ glm::vec3 horizontal_forward(const glm::mat4& m) {
   return len > 1e-6f ? f / len : glm::vec3(0.0f);
 }
 
+namespace {
+
+// Joints in [0, n), ascending.
+bool valid_joint_list(std::span<const int16_t> joints, size_t n) {
+  for (size_t i = 0; i < joints.size(); ++i) {
+    if (joints[i] < 0 || static_cast<size_t>(joints[i]) >= n) return false;
+    if (i > 0 && joints[i] <= joints[i - 1]) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool SampleClipJob::validate() const {
   if (!clip || clip->num_frames <= 0 || clip->fps <= 0.0f) return false;
   const size_t n = static_cast<size_t>(clip->num_joints);
   return out_rotations.size() >= n && out_translations.size() >= n &&
+         valid_joint_list(translated_joints, n) &&
          clip->rotations.size() == n * clip->num_frames &&
          clip->translations.size() == n * clip->num_frames && std::isfinite(time_s);
 }
@@ -209,12 +223,20 @@ FramePair frame_pair(const Clip& clip, float time_s) {
 
 // The two frames are somewhere in the clip, likely out of the caches: ask for all their lines at
 // once rather than one stream after the other.
-void prefetch_frames(const Clip& clip, const FramePair& fp) {
+// With a list of translated joints, only their translations' lines (from the first to the last).
+void prefetch_frames(const Clip& clip, const FramePair& fp, std::span<const int16_t> translated) {
   const size_t n = static_cast<size_t>(clip.num_joints);
   prefetch_bytes(clip.frame_rotations(fp.i0), n * sizeof(glm::quat));
   prefetch_bytes(clip.frame_rotations(fp.i1), n * sizeof(glm::quat));
-  prefetch_bytes(clip.frame_translations(fp.i0), n * sizeof(glm::vec3));
-  prefetch_bytes(clip.frame_translations(fp.i1), n * sizeof(glm::vec3));
+  const size_t first = translated.empty() ? 0 : static_cast<size_t>(translated.front());
+  const size_t count = translated.empty() ? n : translated.back() + 1 - first;
+  prefetch_bytes(clip.frame_translations(fp.i0) + first, count * sizeof(glm::vec3));
+  prefetch_bytes(clip.frame_translations(fp.i1) + first, count * sizeof(glm::vec3));
+}
+
+// a * wa + b * wb, component by component (weighted_floats' arithmetic for one joint).
+glm::vec3 weighted_vec3(const glm::vec3& a, float wa, const glm::vec3& b, float wb) {
+  return {a.x * wa + b.x * wb, a.y * wa + b.y * wb, a.z * wa + b.z * wb};
 }
 
 // Across a loop's wrap the root keeps travelling: frame 0 of the next loop lies one loop's
@@ -262,7 +284,7 @@ void SampleClipJob::run() const {
   const glm::quat* r1 = clip->frame_rotations(fp.i1);
   const glm::vec3* p0 = clip->frame_translations(fp.i0);
   const glm::vec3* p1 = clip->frame_translations(fp.i1);
-  prefetch_frames(*clip, fp);
+  prefetch_frames(*clip, fp, translated_joints);
   int j = 0;
 #if defined(__SSE2__)
   const __m128 s4 = _mm_set1_ps(1.0f - t), t4 = _mm_set1_ps(t);
@@ -276,6 +298,15 @@ void SampleClipJob::run() const {
   }
 #endif
   for (; j < n; ++j) out_rotations[j] = nlerp_shortest(r0[j], r1[j], t);
+  if (!translated_joints.empty()) {  // the listed joints only, with weighted_floats' arithmetic
+    for (const int16_t k : translated_joints) {
+      out_translations[k] = weighted_vec3(p0[k], 1.0f - t, p1[k], t);
+    }
+    if (translated_joints.front() == 0 && crosses_wrap(*clip, fp)) {
+      out_translations[0] += wrap_step(*clip, fp);
+    }
+    return;
+  }
   weighted_floats(reinterpret_cast<const float*>(p0), 1.0f - t, reinterpret_cast<const float*>(p1),
                   t, 3 * static_cast<size_t>(n), reinterpret_cast<float*>(out_translations.data()));
   if (crosses_wrap(*clip, fp)) out_translations[0] += wrap_step(*clip, fp);
@@ -287,7 +318,8 @@ bool SampleBlendJob::validate() const {
     return false;
   }
   for (const Input* in : {&a, &b}) {
-    if (!SampleClipJob{in->clip, in->time_s, out_rotations, out_translations}.validate()) {
+    if (!SampleClipJob{in->clip, in->time_s, out_rotations, out_translations, translated_joints}
+             .validate()) {
       return false;
     }
   }
@@ -297,8 +329,8 @@ bool SampleBlendJob::validate() const {
 void SampleBlendJob::run() const {
   const int n = a.clip->num_joints;
   const FramePair fa = frame_pair(*a.clip, a.time_s), fb = frame_pair(*b.clip, b.time_s);
-  prefetch_frames(*a.clip, fa);
-  prefetch_frames(*b.clip, fb);
+  prefetch_frames(*a.clip, fa, translated_joints);
+  prefetch_frames(*b.clip, fb, translated_joints);
   // BlendPosesJob's weights: each over their sum.
   const float inv_total = 1.0f / (a.weight + b.weight);
   const float wa = a.weight * inv_total, wb = b.weight * inv_total;
@@ -345,8 +377,23 @@ void SampleBlendJob::run() const {
   const float* b1 = reinterpret_cast<const float*>(b.clip->frame_translations(fb.i1));
   float* out = reinterpret_cast<float*>(out_translations.data());
   const size_t m = 3 * static_cast<size_t>(n);
+  if (!translated_joints.empty()) {  // the listed joints only, with the loops' arithmetic below
+    for (const int16_t k : translated_joints) {
+      if (k == 0) continue;  // the root below, with the wraps
+      const float* pa0 = a0 + 3 * k;
+      const float* pa1 = a1 + 3 * k;
+      const float* pb0 = b0 + 3 * k;
+      const float* pb1 = b1 + 3 * k;
+      for (int c = 0; c < 3; ++c) {
+        const float la = pa0[c] * (1.0f - fa.t) + pa1[c] * fa.t;
+        const float lb = pb0[c] * (1.0f - fb.t) + pb1[c] * fb.t;
+        out[3 * k + c] = la * wa + lb * wb;
+      }
+    }
+  }
+  const bool listed = !translated_joints.empty();
   size_t i = 3;  // the root (floats 0-2) first, with the wraps
-  {
+  if (!listed || translated_joints.front() == 0) {
     glm::vec3 ra(a0[0] * (1.0f - fa.t) + a1[0] * fa.t, a0[1] * (1.0f - fa.t) + a1[1] * fa.t,
                  a0[2] * (1.0f - fa.t) + a1[2] * fa.t);
     glm::vec3 rb(b0[0] * (1.0f - fb.t) + b1[0] * fb.t, b0[1] * (1.0f - fb.t) + b1[1] * fb.t,
@@ -356,6 +403,7 @@ void SampleBlendJob::run() const {
     out_translations[0] = glm::vec3(ra.x * wa + rb.x * wb, ra.y * wa + rb.y * wb,
                                     ra.z * wa + rb.z * wb);
   }
+  if (listed) return;  // the listed joints are done
 #if defined(__SSE2__)
   const __m128 sa1 = _mm_set1_ps(1.0f - fa.t), ta1 = _mm_set1_ps(fa.t);
   const __m128 sb1 = _mm_set1_ps(1.0f - fb.t), tb1 = _mm_set1_ps(fb.t);
@@ -378,7 +426,7 @@ void SampleBlendJob::run() const {
 bool BlendPosesJob::validate() const {
   if (layers.empty()) return false;
   const size_t n = out_rotations.size();
-  if (out_translations.size() != n) return false;
+  if (out_translations.size() != n || !valid_joint_list(translated_joints, n)) return false;
   for (const PoseLayer& l : layers) {
     if (l.rotations.size() < n || l.translations.size() < n || !std::isfinite(l.weight)) {
       return false;
@@ -398,13 +446,27 @@ void BlendPosesJob::run() const {
     }
   }
   const size_t n = out_rotations.size();
+  const bool listed = !translated_joints.empty();
   if (weighted <= 1) {  // one layer is the blend (unit rotations stay); none: the first unchanged
     const PoseLayer& only = layers[std::max(first, 0)];
     std::copy_n(only.rotations.begin(), n, out_rotations.begin());
-    std::copy_n(only.translations.begin(), n, out_translations.begin());
+    if (!listed) {
+      std::copy_n(only.translations.begin(), n, out_translations.begin());
+    } else {
+      for (const int16_t k : translated_joints) out_translations[k] = only.translations[k];
+    }
     return;
   }
   const float inv_total = 1.0f / total;
+  if (listed) {  // the listed joints' translations as the scalar loop below has them
+    for (const int16_t k : translated_joints) {
+      glm::vec3 p(0.0f);
+      for (const PoseLayer& l : layers) {
+        if (l.weight > 0.0f) p += (l.weight * inv_total) * l.translations[k];
+      }
+      out_translations[k] = p;
+    }
+  }
   size_t j = 0;
 #if defined(__SSE2__)
   if (weighted == 2) {
@@ -422,9 +484,11 @@ void BlendPosesJob::run() const {
       const __m128 negate = _mm_cmplt_ps(dot4(a, b), _mm_setzero_ps());
       store4(normalize4(weighted_sum4(a, wa4, b, wb4, negate)), out_rotations.data() + j);
     }
-    weighted_floats(reinterpret_cast<const float*>(la.translations.data()), wa,
-                    reinterpret_cast<const float*>(lb.translations.data()), wb, 3 * n,
-                    reinterpret_cast<float*>(out_translations.data()));
+    if (!listed) {
+      weighted_floats(reinterpret_cast<const float*>(la.translations.data()), wa,
+                      reinterpret_cast<const float*>(lb.translations.data()), wb, 3 * n,
+                      reinterpret_cast<float*>(out_translations.data()));
+    }
   }
 #endif
   for (; j < n; ++j) {
@@ -439,7 +503,7 @@ void BlendPosesJob::run() const {
       p += w * l.translations[j];
     }
     out_rotations[j] = glm::normalize(q);
-    out_translations[j] = p;
+    if (!listed) out_translations[j] = p;
   }
 }
 

@@ -24,6 +24,11 @@ struct SampleClipJob {
   float time_s = 0.0f;
   std::span<glm::quat> out_rotations;     // num_joints
   std::span<glm::vec3> out_translations;  // num_joints
+  // Non-empty: only these joints' translations (ascending) are sampled and written; the others
+  // are left as they are in out_translations. For joints whose translation is the same in every
+  // frame of every clip (a BVH's offsets): the caller keeps that value there once, and a lerp or
+  // blend of it per agent would only round it.
+  std::span<const int16_t> translated_joints;
   bool validate() const;
   void run() const;
 };
@@ -41,6 +46,11 @@ struct SampleBlendJob {
   Input a, b;  // clips of the same skeleton
   std::span<glm::quat> out_rotations;     // num_joints
   std::span<glm::vec3> out_translations;  // num_joints
+  // Non-empty: only these joints' translations (ascending) are sampled and written; the others
+  // are left as they are in out_translations. For joints whose translation is the same in every
+  // frame of every clip (a BVH's offsets): the caller keeps that value there once, and a lerp or
+  // blend of it per agent would only round it.
+  std::span<const int16_t> translated_joints;
   bool validate() const;
   void run() const;
 };
@@ -60,6 +70,11 @@ struct BlendPosesJob {
   std::span<const PoseLayer> layers;
   std::span<glm::quat> out_rotations;
   std::span<glm::vec3> out_translations;
+  // Non-empty: only these joints' translations (ascending) are blended and written; the others
+  // are left as they are in out_translations. For joints whose translation is the same in every
+  // frame of every layer: the caller keeps that value there once, and a lerp or
+  // blend of it per agent would only round it.
+  std::span<const int16_t> translated_joints;
   bool validate() const;
   void run() const;
 };

@@ -124,14 +124,43 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.heel_pitch.assign(capacity * 2, 0.0f);
   locks_.heel_pitch_rate.assign(capacity * 2, 0.0f);
   locks_.lift_share.assign(capacity * 2, 0.0f);
+  // Joints whose local translation is the same in every frame of every clip (a BVH's offsets:
+  // every joint but the root in the built-in and CMU sets) are not sampled per agent: that value
+  // is kept in each thread's local translations once, and only the others are sampled (when they
+  // are few; a set with most joints translated samples them all four floats at a time).
+  std::vector<glm::vec3> fixed_trans = skeleton_.rest_translations;
+  fixed_trans.resize(J, glm::vec3(0.0f));
+  bool clips_fit = !library.clips.empty();
+  for (const LocomotionClip& lc : library.clips) {
+    clips_fit = clips_fit && lc.clip.num_joints == num_joints_ && lc.clip.num_frames > 0;
+  }
+  if (clips_fit) {
+    const Clip& first = library.clips.front().clip;
+    for (size_t j = 0; j < J; ++j) {
+      const glm::vec3 v = first.frame_translations(0)[j];
+      bool same = true;
+      for (const LocomotionClip& lc : library.clips) {
+        for (int f = 0; same && f < lc.clip.num_frames; ++f) {
+          same = lc.clip.frame_translations(f)[j] == v;
+        }
+      }
+      if (same) {
+        fixed_trans[j] = v;
+      } else {
+        translated_joints_.push_back(static_cast<int16_t>(j));
+      }
+    }
+    if (2 * translated_joints_.size() > J) translated_joints_.clear();  // all, four-wide
+    if (translated_joints_.empty()) fixed_trans.assign(J, glm::vec3(0.0f));
+  }
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   coarse_ = make_coarse_rig(library);
   const size_t K = static_cast<size_t>(coarse_.num_coarse);
-  scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J, K] {
+  scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J, K, fixed_trans] {
     Scratch s;
     s.rot.resize(2 * kMaxBlendLayers * J);
     s.trans.resize(2 * kMaxBlendLayers * J);
-    s.local_trans.resize(J);
+    s.local_trans = fixed_trans;  // the fixed ones stay; the others are sampled per agent
     s.coarse_rot.resize(K);
     s.coarse_trans.resize(K);
     s.world.resize(J);
@@ -257,7 +286,16 @@ void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot,
     const int i0 = static_cast<int>(f);
     const size_t rows = static_cast<size_t>(clip.num_joints) * (i0 + 1 < clip.num_frames ? 2 : 1);
     prefetch_bytes(clip.frame_rotations(i0), rows * sizeof(glm::quat));  // frames i0 and i0 + 1
-    prefetch_bytes(clip.frame_translations(i0), rows * sizeof(glm::vec3));
+    if (coarse || translated_joints_.empty()) {
+      prefetch_bytes(clip.frame_translations(i0), rows * sizeof(glm::vec3));
+    } else {  // only the sampled joints' translations (from the first to the last), both frames
+      const size_t from = static_cast<size_t>(translated_joints_.front());
+      const size_t count = translated_joints_.back() + 1 - from;
+      prefetch_bytes(clip.frame_translations(i0) + from, count * sizeof(glm::vec3));
+      if (i0 + 1 < clip.num_frames) {
+        prefetch_bytes(clip.frame_translations(i0 + 1) + from, count * sizeof(glm::vec3));
+      }
+    }
   }
   if (!stream_world_) prefetch_bytes(world_.data() + base, J * sizeof(glm::mat4), true);
   if (coarse) return;
@@ -323,8 +361,11 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
     (a < 0 ? a : b) = i;
     ++num_weighted;
   }
+  // The coarse clips have joints of their own: all sampled.
+  const std::span<const int16_t> translated =
+      coarse ? std::span<const int16_t>() : std::span<const int16_t>(translated_joints_);
   if (num_weighted == 1) {
-    SampleClipJob{clip_of[a], time_of[a], out_rot, out_trans}.run();
+    SampleClipJob{clip_of[a], time_of[a], out_rot, out_trans, translated}.run();
     return;
   }
   if (num_weighted == 2) {
@@ -337,6 +378,7 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
     job.b.weight = weight_of[b];
     job.out_rotations = out_rot;
     job.out_translations = out_trans;
+    job.translated_joints = translated;
     job.run();
     return;
   }
@@ -344,10 +386,10 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
   for (int i = 0; i < num_samples; ++i) {
     std::span<glm::quat> r(s.rot.data() + i * n, n);
     std::span<glm::vec3> t(s.trans.data() + i * n, n);
-    SampleClipJob{clip_of[i], time_of[i], r, t}.run();
+    SampleClipJob{clip_of[i], time_of[i], r, t, translated}.run();
     layers[i] = {r, t, weight_of[i]};
   }
-  BlendPosesJob{{layers, static_cast<size_t>(num_samples)}, out_rot, out_trans}.run();
+  BlendPosesJob{{layers, static_cast<size_t>(num_samples)}, out_rot, out_trans, translated}.run();
 }
 
 void PoseSynthesizer::fk(glm::mat4* world, const glm::quat* rot, const glm::vec3* trans, int from,

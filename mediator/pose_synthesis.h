@@ -176,6 +176,9 @@ class PoseSynthesizer {
   // the sides it turns (bit 0 left, bit 1 right).
   std::vector<int16_t> leg_fk_[4], foot_fk_[4];
   CoarseRig coarse_;  // the joints a kLight pose samples (mediator/coarse_pose.h)
+  // The joints whose translations are sampled per agent (ascending), or empty: all of them. The
+  // others' are the same in every frame of every clip and kept in each Scratch's local_trans.
+  std::vector<int16_t> translated_joints_;
   bool affine_inverse_bind_ = false;
   bool translation_inverse_bind_ = false;  // is_translation(inverse_bind_): the cheaper palette
   bool stream_palettes_ = false;

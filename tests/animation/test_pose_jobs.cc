@@ -1,6 +1,7 @@
 // Runtime jobs checked against closed-form expectations: interpolation, looping, blending, FK of a
 // chain with known geometry, and two-bone IK reaching random targets with the knee toward the pole.
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -235,6 +236,60 @@ TEST(SampleBlendJob, EqualsTwoSamplesAndTheirBlendBitForBit) {
       }
     }
   }
+}
+
+// With a list of translated joints, the jobs write those joints' translations as they would
+// without it (the same bits; the root's step across a wrap too) and leave the others alone.
+TEST(PoseJobs, TranslatedJointsOnlyAreWrittenAsWithoutTheList) {
+  std::mt19937 rng(33);
+  const int n = 11;
+  const Clip a = random_clip(n, 7, rng), b = random_clip(n, 9, rng);
+  const std::vector<int16_t> lists[] = {{0}, {0, 3, 10}, {2, 5}};
+  const glm::vec3 kept(7.0f, -7.0f, 7.0f);
+  for (const std::vector<int16_t>& list : lists) {
+    for (const float time : {0.05f, (a.num_frames - 0.4f) / a.fps}) {
+      std::vector<glm::quat> r(n), r_all(n), rb(n);
+      std::vector<glm::vec3> t(n, kept), t_all(n), tb(n, kept), tb_all(n);
+      SampleClipJob all{&a, time, r_all, t_all};
+      all.run();
+      SampleClipJob some{&a, time, r, t, list};
+      ASSERT_TRUE(some.validate());
+      some.run();
+      SampleClipJob{&b, 0.5f * time, rb, tb_all}.run();
+      SampleClipJob{&b, 0.5f * time, rb, tb, list}.run();
+      SampleBlendJob blend;
+      blend.a = {&a, time, 0.7f};
+      blend.b = {&b, 0.5f * time, 1.3f};
+      blend.out_rotations = r_all;
+      blend.out_translations = t_all;
+      std::vector<glm::vec3> blend_all(n), blend_some(n, kept);
+      blend.out_translations = blend_all;
+      blend.run();
+      blend.out_translations = blend_some;
+      blend.translated_joints = list;
+      ASSERT_TRUE(blend.validate());
+      blend.run();
+      std::vector<glm::vec3> layers_all(n), layers_some(n, kept);
+      const PoseLayer layers[3] = {{r_all, t_all, 0.5f}, {rb, tb_all, 0.25f}, {rb, tb_all, 1.0f}};
+      BlendPosesJob{layers, r, layers_all}.run();
+      BlendPosesJob{layers, r, layers_some, list}.run();
+      std::vector<glm::vec3> two_all(n), two_some(n, kept);  // two layers: the four-wide path
+      BlendPosesJob{{layers, 2}, r, two_all}.run();
+      BlendPosesJob{{layers, 2}, r, two_some, list}.run();
+      for (int j = 0; j < n; ++j) {
+        const bool listed = std::find(list.begin(), list.end(), j) != list.end();
+        EXPECT_EQ(t[j], listed ? t_all[j] : kept) << "joint " << j;
+        EXPECT_EQ(blend_some[j], listed ? blend_all[j] : kept) << "joint " << j;
+        EXPECT_EQ(layers_some[j], listed ? layers_all[j] : kept) << "joint " << j;
+        EXPECT_EQ(two_some[j], listed ? two_all[j] : kept) << "joint " << j;
+      }
+    }
+  }
+  std::vector<glm::quat> r(n);
+  std::vector<glm::vec3> t(n);
+  const std::vector<int16_t> unordered = {3, 1}, outside = {0, 11};
+  EXPECT_FALSE((SampleClipJob{&a, 0.0f, r, t, unordered}.validate()));
+  EXPECT_FALSE((SampleClipJob{&a, 0.0f, r, t, outside}.validate()));
 }
 
 TEST(SampleBlendJob, ValidateRefusesUnweightedOrMismatchedInputs) {
