@@ -289,6 +289,12 @@ void SampleClipJob::run() const {
 #if defined(__SSE2__)
   const __m128 s4 = _mm_set1_ps(1.0f - t), t4 = _mm_set1_ps(t);
   for (; j + 4 <= n; j += 4) store4(sample4(r0 + j, r1 + j, s4, t4), out_rotations.data() + j);
+  if (j < n && n >= 4) {
+    // The last four joints again (each lane's arithmetic is its own: the ones done already come
+    // out the same), rather than the rest padded through a copy.
+    store4(sample4(r0 + n - 4, r1 + n - 4, s4, t4), out_rotations.data() + n - 4);
+    j = n;
+  }
   if (j < n) {
     const Tail4 a(r0 + j, n - j), b(r1 + j, n - j);
     glm::quat out[4];
@@ -352,6 +358,11 @@ void SampleBlendJob::run() const {
   };
   for (; j + 4 <= n; j += 4) {
     blend4(a0r + j, a1r + j, b0r + j, b1r + j, out_rotations.data() + j);
+  }
+  if (j < n && n >= 4) {  // the last four again, as SampleClipJob's
+    const int k = n - 4;
+    blend4(a0r + k, a1r + k, b0r + k, b1r + k, out_rotations.data() + k);
+    j = n;
   }
   if (j < n) {  // the rest padded to four (as the loop below, but for the sign of a zero)
     const Tail4 ta0(a0r + j, n - j), ta1(a1r + j, n - j), tb0(b0r + j, n - j),
@@ -488,6 +499,49 @@ void BlendPosesJob::run() const {
       weighted_floats(reinterpret_cast<const float*>(la.translations.data()), wa,
                       reinterpret_cast<const float*>(lb.translations.data()), wb, 3 * n,
                       reinterpret_cast<float*>(out_translations.data()));
+    }
+  } else {
+    // Three or more layers (a blend with a take's seam), four joints at a time: the loop below's
+    // sums from 0 in its order, each lane one joint, so the same bits (the scalar loop cost four
+    // times as much).
+    const __m128 zero = _mm_setzero_ps(), sign_bit = _mm_set1_ps(-0.0f);
+    for (; j + 4 <= n; j += 4) {
+      const Quat4 ref = load4(layers[first].rotations.data() + j);
+      Quat4 q{zero, zero, zero, zero};
+      for (const PoseLayer& l : layers) {
+        if (l.weight <= 0.0f) continue;
+        const Quat4 lq = load4(l.rotations.data() + j);
+        // -w where the layer is in the other hemisphere than the first one: a sign flip, exact.
+        const __m128 w = _mm_xor_ps(_mm_set1_ps(l.weight * inv_total),
+                                    _mm_and_ps(_mm_cmplt_ps(dot4(ref, lq), zero), sign_bit));
+        q.x = _mm_add_ps(q.x, _mm_mul_ps(w, lq.x));
+        q.y = _mm_add_ps(q.y, _mm_mul_ps(w, lq.y));
+        q.z = _mm_add_ps(q.z, _mm_mul_ps(w, lq.z));
+        q.w = _mm_add_ps(q.w, _mm_mul_ps(w, lq.w));
+      }
+      store4(normalize4(q), out_rotations.data() + j);
+    }
+    if (!listed) {  // every joint's translation, as floats (the joints after j again below)
+      float* out = reinterpret_cast<float*>(out_translations.data());
+      const size_t m = 3 * n;
+      size_t i = 0;
+      for (; i + 4 <= m; i += 4) {
+        __m128 p = zero;
+        for (const PoseLayer& l : layers) {
+          if (l.weight <= 0.0f) continue;
+          const float* t = reinterpret_cast<const float*>(l.translations.data());
+          p = _mm_add_ps(p, _mm_mul_ps(_mm_set1_ps(l.weight * inv_total), _mm_loadu_ps(t + i)));
+        }
+        _mm_storeu_ps(out + i, p);
+      }
+      for (; i < m; ++i) {
+        float p = 0.0f;
+        for (const PoseLayer& l : layers) {
+          if (l.weight <= 0.0f) continue;
+          p += (l.weight * inv_total) * reinterpret_cast<const float*>(l.translations.data())[i];
+        }
+        out[i] = p;
+      }
     }
   }
 #endif

@@ -164,6 +164,48 @@ TEST(BlendPosesJob, TwoLayersOfManyJointsEachAsTheFormula) {
   }
 }
 
+// Three or more layers go four joints at a time: the same bits as the plain loop (sums from 0
+// in layer order, each layer's weight negated outside the first's hemisphere), any joint count.
+TEST(BlendPosesJob, ManyLayersFourJointsAtATimeEqualThePlainLoopBitForBit) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), weight(0.01f, 2.0f);
+  for (const int n : {1, 3, 4, 7, 25}) {
+    for (const int num_layers : {3, 4}) {
+      std::vector<std::vector<glm::quat>> r(num_layers);
+      std::vector<std::vector<glm::vec3>> t(num_layers);
+      std::vector<PoseLayer> layers;
+      for (int l = 0; l < num_layers; ++l) {
+        r[l] = random_quats(n, rng, nullptr);
+        for (int j = 0; j < n; ++j) t[l].push_back(glm::vec3(u(rng), u(rng), u(rng)));
+        layers.push_back({r[l], t[l], l == 1 ? 0.0f : weight(rng)});  // one weightless layer
+      }
+      if (num_layers == 3) layers[1].weight = weight(rng);  // three weighted
+      float total = 0.0f;
+      for (const PoseLayer& l : layers) total += l.weight > 0.0f ? l.weight : 0.0f;
+      const float inv_total = 1.0f / total;
+      std::vector<glm::quat> got_r(n);
+      std::vector<glm::vec3> got_t(n);
+      BlendPosesJob{layers, got_r, got_t}.run();
+      int first = 0;
+      while (!(layers[first].weight > 0.0f)) ++first;
+      for (int j = 0; j < n; ++j) {
+        glm::quat q(0, 0, 0, 0);
+        glm::vec3 p(0.0f);
+        for (const PoseLayer& l : layers) {
+          if (l.weight <= 0.0f) continue;
+          const float w = l.weight * inv_total;
+          q += (glm::dot(layers[first].rotations[j], l.rotations[j]) < 0.0f ? -w : w) *
+               l.rotations[j];
+          p += w * l.translations[j];
+        }
+        const glm::quat want = glm::normalize(q);
+        for (int k = 0; k < 4; ++k) ASSERT_EQ(got_r[j][k], want[k]) << "n " << n << " joint " << j;
+        for (int k = 0; k < 3; ++k) ASSERT_EQ(got_t[j][k], p[k]) << "n " << n << " joint " << j;
+      }
+    }
+  }
+}
+
 TEST(BlendPosesJob, OneWeightedLayerIsCopied) {
   const glm::quat a = glm::angleAxis(glm::radians(20.0f), glm::vec3(0, 0, 1));
   const glm::quat b = glm::angleAxis(glm::radians(70.0f), glm::vec3(1, 0, 0));
