@@ -504,9 +504,11 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
   const FootTracks tracks = foot_tracks(lc.clip, sk);
   const FootTracks world = foot_tracks(span, sk);  // with the take's root motion
   const ContactThresholds ct;
+  const std::vector<uint8_t> down[2] = {contact_frames(lc.analysis, 0, n, lc.clip.fps, false),
+                                        contact_frames(lc.analysis, 1, n, lc.clip.fps, false)};
   for (int s = 0; s < 2; ++s) {
-    const std::vector<uint8_t> contact = contact_frames(lc.analysis, s, n, lc.clip.fps, false);
-    const std::vector<uint8_t> other = contact_frames(lc.analysis, 1 - s, n, lc.clip.fps, false);
+    const std::vector<uint8_t>& contact = down[s];
+    const std::vector<uint8_t>& other = down[1 - s];
     std::vector<float> ground(n, 0.0f);
     for (int f = 0; f < n; ++f) {
       const int a = std::max(0, f - 1), b = std::min(n - 1, f + 1);
@@ -609,8 +611,8 @@ void set_lift_phases(LocomotionClip* lc) {
     float least = 2.0f;
     for (int k = 0; k < kPhaseTableSize; ++k) {
       const float phase = static_cast<float>(k) / kPhaseTableSize;
-      int f = static_cast<int>(std::lround(lc->time_at_phase(phase) * lc->clip.fps));
-      f = lc->clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
+      const int f =
+          lc->wrap_frame(static_cast<int>(std::lround(lc->time_at_phase(phase) * lc->clip.fps)));
       const float progress = lc->swing_progress[s][f];
       if (progress > 0.0f && progress < least) {
         least = progress;

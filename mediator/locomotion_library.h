@@ -67,6 +67,13 @@ struct LocomotionClip {
   // taken out frame by frame (not at one mean speed), so the pose keeps only the pelvis's sway.
   bool transition = false;
   float time_at_phase(float phase) const;  // phase in [0, 1)
+  // Frame index i of the clip wrapped (a loop) or clamped into range; one already in range is
+  // its own (no division: the per-frame contacts pass calls it per layer).
+  int wrap_frame(int i) const {
+    const int nf = clip.num_frames;
+    if (i >= 0 && i < nf) return i;
+    return clip.loops ? ((i % nf) + nf) % nf : (i < 0 ? 0 : nf - 1);
+  }
 };
 
 // A start (standing -> steady gait) or a stop (steady gait -> standing) found in a take, kept as

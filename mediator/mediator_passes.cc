@@ -248,8 +248,7 @@ void weights_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       const float step = dt / P.blend_time_s;
       float diff = 0.0f;
       for (size_t k = 0; k < nc; ++k) {
-        const float d = target_w[k] - w[k];
-        w[k] += std::clamp(d, -step, step);
+        w[k] = approach(w[k], target_w[k], step);
         diff += std::abs(target_w[k] - w[k]);
       }
       out_blend_progress[slot] = 1.0f - 0.5f * diff;
@@ -648,11 +647,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       const LocomotionClip& clip = lib.clips[lc[k]];
       lt[k] = layer_time(clip, phase[slot], idle_time_s[slot], transition_time_s[slot]);
       if (lw[k] <= 0.0f) continue;
-      const int nf = clip.clip.num_frames;
-      auto wrap = [&](int i) {  // a frame already in range is its own (no division)
-        if (i >= 0 && i < nf) return i;
-        return clip.clip.loops ? ((i % nf) + nf) % nf : std::clamp(i, 0, nf - 1);
-      };
+      auto wrap = [&clip](int i) { return clip.wrap_frame(i); };
       const float ft = lt[k] * clip.clip.fps;
       const int f = wrap(static_cast<int>(std::lround(ft)));
       // Toe heights between frames (a 24 or 30 fps clip must not step the foot every other

@@ -24,9 +24,7 @@ constexpr float kDt = 1.0f / 60.0f;
 
 // The clip frame at a gait phase, as the mediator samples it.
 int frame_at_phase(const LocomotionClip& c, float phase) {
-  const int nf = c.clip.num_frames;
-  const int f = static_cast<int>(std::lround(c.time_at_phase(phase) * c.clip.fps));
-  return c.clip.loops ? ((f % nf) + nf) % nf : std::clamp(f, 0, nf - 1);
+  return c.wrap_frame(static_cast<int>(std::lround(c.time_at_phase(phase) * c.clip.fps)));
 }
 
 // Each foot's lift phase is where the clip's own contact labels (`plant`) go from down to up, and
@@ -43,9 +41,8 @@ void check_lift_phases(const LocomotionLibrary& lib) {
       // A phase step earlier (one sample of the phase table) it is still down, or at most a
       // frame of the clip has passed since it left.
       const int before = frame_at_phase(c, c.lift_phase[s] - 1.0f / kPhaseTableSize);
-      const int nf = c.clip.num_frames;
       const bool down_before = c.plant[s][before] != 0;
-      const bool just_left = c.plant[s][((before - 1) % nf + nf) % nf] != 0;
+      const bool just_left = c.plant[s][c.wrap_frame(before - 1)] != 0;
       EXPECT_TRUE(down_before || just_left) << c.clip.name << " side " << s;
     }
     if (std::abs(c.direction_rad) < 0.3f) {
