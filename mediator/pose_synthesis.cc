@@ -780,11 +780,13 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     if (glm::length(goal_ankle - hip_p) > limit + 1e-3f &&
         locks_.lock[k].state == FootLockState::kLocked) {
       // Overstretched even with the pelvis down and the heel up: the foot steps to where the clip
-      // has it while the clip keeps it on the ground, and is let go when the clip lifts it.
+      // has it while the clip keeps its weight on it (in contact, or a trailing ball pushing off),
+      // and is let go when the clip lifts it. A step rises before it moves: let go low at push-off
+      // instead, the trailing foot would catch up with the clip's along the floor.
       const glm::vec3 drawn = translation_of(world[skeleton_.toe(sd)]) + toe_offset[side];
       const FootLockState other_state =
           locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
-      if (!letting_go && pl.plant[side][slot] >= 0.5f && other_state == FootLockState::kLocked) {
+      if (!letting_go && pl.hold[side][slot] >= 0.5f && other_state == FootLockState::kLocked) {
         locks_.lock[k] = start_foot_step(locks_.lock[k], drawn);
       } else if (other_state == FootLockState::kStepping) {
         // The other foot is in the air: this one keeps the weight and is re-pinned where the leg
