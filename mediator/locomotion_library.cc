@@ -337,8 +337,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     // lands is lifted later, in the air, by the release).
     for (int f = 0; f < n; ++f) {
       const bool low = lc->toe_height_m[s][f] <= max_h;
-      lc->hold[s][f] =
-          lc->plant[s][f] || (low && (speed[f] <= max_v || down[1 - s][f] != 0));
+      lc->hold[s][f] = lc->plant[s][f] || (low && (speed[f] <= max_v || down[1 - s][f] != 0));
     }
   }
 }
@@ -560,6 +559,58 @@ float landing_phase(const LocomotionClip& cycle, int side) {
   }
   return -1.0f;
 }
+
+// Transition::phase_track of a transition clip `lc` joining `cycle` (its landings: contacts that
+// begin after the clip's first frame, which is a cut, not a landing).
+std::vector<float> transition_phase_track(const LocomotionClip& lc, const LocomotionClip& cycle,
+                                          float fps, float frame_s) {
+  struct Landing {
+    float t;
+    int side;
+  };
+  std::vector<Landing> landings;
+  for (int s = 0; s < 2; ++s) {
+    for (const TimeInterval& c : lc.analysis.contacts[s]) {
+      if (c.start_s >= 0.5f * frame_s && landing_phase(cycle, s) >= 0.0f) {
+        landings.push_back({c.start_s, s});
+      }
+    }
+  }
+  std::sort(landings.begin(), landings.end(),
+            [](const Landing& a, const Landing& b) { return a.t < b.t; });
+  // Unwrapped: each landing is the cycle's landing of that foot, the next one on from the last
+  // (half a cycle for the other foot; the same foot twice in a row, a whole cycle).
+  std::vector<float> at(landings.size());
+  for (size_t i = 0; i < landings.size(); ++i) {
+    const float p = landing_phase(cycle, landings[i].side);
+    if (i == 0) {
+      at[i] = p;
+      continue;
+    }
+    float d = p - at[i - 1];
+    d -= std::floor(d);
+    if (d < 0.25f) d += 1.0f;
+    at[i] = at[i - 1] + d;
+  }
+  const int n = lc.clip.num_frames;
+  std::vector<float> track(static_cast<size_t>(std::max(n, 0)), 0.0f);
+  for (int f = 0; f < n; ++f) {
+    const float t = static_cast<float>(f) / fps;
+    if (landings.empty()) {
+      track[f] = t / cycle.cycle_s;
+    } else if (t <= landings.front().t) {
+      track[f] = at.front() - (landings.front().t - t) / cycle.cycle_s;
+    } else if (t >= landings.back().t) {
+      track[f] = at.back() + (t - landings.back().t) / cycle.cycle_s;
+    } else {
+      size_t i = 1;
+      while (landings[i].t < t) ++i;
+      const float u = (t - landings[i - 1].t) / std::max(landings[i].t - landings[i - 1].t, 1e-6f);
+      track[f] = at[i - 1] + u * (at[i] - at[i - 1]);
+    }
+  }
+  return track;
+}
 }  // namespace
 
 const char* transition_kind_name(TransitionKind kind) {
@@ -572,6 +623,19 @@ float Transition::speed_at(float t_s) const {
   const size_t i = std::min(static_cast<size_t>(x), speed_m_s.size() - 1);
   const size_t j = std::min(i + 1, speed_m_s.size() - 1);
   return speed_m_s[i] + (x - static_cast<float>(i)) * (speed_m_s[j] - speed_m_s[i]);
+}
+
+float Transition::phase_at(float t_s) const {
+  const size_t n = phase_track.size();
+  if (n == 0) return 0.0f;
+  if (n == 1) return phase_track[0] - std::floor(phase_track[0]);
+  // Between frames linearly; beyond the ends on along the end's own slope (the cycle's rate), so
+  // a start handing over at its last frame leaves the phase moving as the cycle goes on.
+  const float x = t_s * fps;
+  const size_t i = x <= 0.0f ? 0 : std::min(static_cast<size_t>(x), n - 2);
+  const float p =
+      phase_track[i] + (x - static_cast<float>(i)) * (phase_track[i + 1] - phase_track[i]);
+  return p - std::floor(p);
 }
 
 float LocomotionClip::time_at_phase(float phase) const {
@@ -1241,6 +1305,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     const float cycle_s = lib.clips[tr.cycle_clip].cycle_s;
     float phase = start ? lp + (tr.duration_s - land) / cycle_s : lp - land / cycle_s;
     tr.cycle_phase = phase - std::floor(phase);
+    tr.phase_track = transition_phase_track(lc, lib.clips[tr.cycle_clip], tr.fps, frame);
     tr.clip = static_cast<int>(lib.clips.size());
     lib.clips.push_back(std::move(lc));
     lib.transitions.push_back(std::move(tr));

@@ -101,7 +101,14 @@ struct Transition {
   // standing speed (0.15 m/s, as take segmentation) lies before / after it.
   float moving_from_s = 0.0f;
   float moving_to_s = 0.0f;
+  // The cycle's gait phase per clip frame, unwrapped (in cycles): at each of the clip's own
+  // landings the phase at which the cycle lands that foot, in between as time goes (a stop's
+  // slowing steps take longer than the cycle's), beyond the first and last at the cycle's own
+  // rate. What the gait phase follows while the transition plays, and where a stop may begin:
+  // the blend's cycle steps with the transition's feet, not with a clock that drifts from them.
+  std::vector<float> phase_track;
   float speed_at(float t_s) const;  // speed_m_s between frames, held beyond the ends
+  float phase_at(float t_s) const;  // phase_track between frames, in [0, 1)
 };
 
 // What the library made of a take with root motion: its segments and the clips cut from it.

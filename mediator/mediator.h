@@ -114,8 +114,8 @@ class Mediator {
   // Per slot, carried from frame to frame.
   std::vector<glm::vec2> vel_, vel_rate_;  // velocity spring
   std::vector<float> theta_, theta_rate_;  // theta spring (unwrapped)
-  bool library_doubtful_ = false;  // gait_analysis_doubtful(library_), found once
-  bool degraded_ = false;          // apm asked, naive played (a doubtful library)
+  bool library_doubtful_ = false;          // gait_analysis_doubtful(library_), found once
+  bool degraded_ = false;                  // apm asked, naive played (a doubtful library)
   std::vector<float> fed_speed_;           // the speed the simulator was last given [m/s]
   std::vector<float> lower_target_;        // target facing of the lower body
   std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
@@ -124,8 +124,8 @@ class Mediator {
   // Transitions (mediator_passes.h, TransitionState).
   std::vector<int16_t> tr_index_;
   std::vector<TransitionStage> tr_stage_;
-  std::vector<float> tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_min_cadence_, tr_lag_,
-      tr_prev_speed_, tr_prev_phase_;
+  std::vector<float> tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_min_cadence_, tr_chosen_speed_,
+      tr_lag_, tr_prev_speed_, tr_prev_phase_;
   std::vector<float> tr_still_, tr_moving_;
   std::vector<uint32_t> tr_counts_;  // [slot * kNumCounts + k]
   // Per slot, scratch between passes.

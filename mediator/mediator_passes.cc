@@ -298,10 +298,9 @@ GaitFrequency gait_frequency(const LocomotionLibrary& lib, const int16_t* lc, co
 void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
                      std::span<const float> cadence_scale, std::span<const float> lower_yaw,
-                     std::span<const float> transition_weight,
-                     std::span<float> phase, std::span<float> idle_time_s,
-                     std::span<float> out_playback_rate, std::span<float> out_gait_weight,
-                     std::span<float> out_travel_yaw) {
+                     std::span<const float> transition_weight, std::span<float> phase,
+                     std::span<float> idle_time_s, std::span<float> out_playback_rate,
+                     std::span<float> out_gait_weight, std::span<float> out_travel_yaw) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   for_each_agent(c, [&](size_t, int slot) {
@@ -465,9 +464,11 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       // Slowing down: a stop when the speed, falling as it does, reaches rest within the stop
       // clip's own stopping time (with some slack), from a speed the clip walks at.
       // It is entered where the clip has slowed to the agent's speed (a slow agent plays only
-      // the stop's last steps). The stop nearest in speed, or its mirror image (the same stop
-      // ending on the other foot): of the two, the one that fits whose first step comes sooner
-      // in the gait, so the agent waits at most about a step for it.
+      // the stop's last steps), or later where the clip is slower still but the agent can play
+      // it and still come to rest in time. The stop nearest in speed, or its mirror image (the
+      // same stop ending on the other foot), at the entry whose step comes soonest in the gait,
+      // so the agent waits at most about a step for it (an agent in a jam that slows to rest in
+      // a step or two would otherwise stand before its stop begins).
       const int nearest = nearest_transition(lib, TransitionKind::kStop, v);
       const float near_v = nearest >= 0 ? lib.transitions[nearest].moving_speed_m_s : 0.0f;
       const float to_rest = v / -accel;
@@ -485,15 +486,23 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
               v <= 1.3f * tr.moving_speed_m_s && entry < tr.moving_to_s)) {
           continue;
         }
-        const LocomotionClip& cyc = lib.clips[tr.cycle_clip];
-        float entry_phase = tr.cycle_phase + (entry - tr.moving_from_s) / cyc.cycle_s;
-        entry_phase -= std::floor(entry_phase);
-        float wait = entry_phase - phase[slot];
-        wait -= std::floor(wait);
-        if (k < 0 || wait < k_wait) {
-          k = static_cast<int>(i);
-          k_wait = wait;
-          k_entry = entry;
+        // Later entries, where the clip is slower still, as long as the agent can play them
+        // (its speed within the clip's at the fastest rate) and still comes to rest in time.
+        const float frame = 1.0f / tr.fps;
+        float last = entry;
+        while (last + frame < tr.moving_to_s &&
+               tr.speed_at(last + frame) * P.max_playback_rate >= v &&
+               to_rest <= 1.25f * (tr.moving_to_s - last - frame) + 0.2f) {
+          last += frame;
+        }
+        for (float e = entry; e <= last + 1e-4f; e += frame) {
+          float wait = tr.phase_at(e) - phase[slot];
+          wait -= std::floor(wait);
+          if (k < 0 || wait < k_wait) {
+            k = static_cast<int>(i);
+            k_wait = wait;
+            k_entry = e;
+          }
         }
       }
       if (k >= 0) {
@@ -503,6 +512,7 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
         // A walker who has chosen to stop keeps the cadence to the step the stop begins on
         // (the slowing shortens the steps, as the stop clip then does): the weights hold it.
         st.min_cadence[slot] = playback_rate[slot];
+        st.chosen_speed_m_s[slot] = v;
         t = k_entry;
         w = 0.0f;
       }
@@ -516,14 +526,14 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     const bool start = tr.kind == TransitionKind::kStart;
     if (stage == TransitionStage::kWaiting) {
       // The stop begins on the gait phase its first landing matches; it is given up if the agent
-      // speeds up again, stands before that phase comes, or the phase does not come within a
-      // cycle at the held cadence (the agent is not walking).
+      // walks on (faster than when it chose the stop: a frame's rise of a speed that jitters
+      // while it slows, as in a jam, is not), stands before that phase comes, or the phase does
+      // not come within a cycle at the held cadence (the agent is not walking).
       st.waited_s[slot] += dt;
-      float entry_phase = tr.cycle_phase + (t - tr.moving_from_s) / cycle.cycle_s;
-      entry_phase -= std::floor(entry_phase);
+      const float entry_phase = tr.phase_at(t);
       const float cycle_time =
           cycle.cycle_s / std::max(st.min_cadence[slot], P.min_playback_rate) + 0.1f;
-      if (accel > 0.0f || stand || st.waited_s[slot] > cycle_time) {
+      if (v > st.chosen_speed_m_s[slot] || stand || st.waited_s[slot] > cycle_time) {
         stage = TransitionStage::kNone;
         index = -1;
         st.min_cadence[slot] = 0.0f;
@@ -582,10 +592,8 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       st.prev_phase[slot] = phase[slot];
       return;
     }
-    // The gait phase follows the transition's clock: the cycle joins (or leaves) in step.
-    const float joint_s = start ? tr.duration_s : tr.moving_from_s;  // the phase is cycle_phase
-    const float ph = tr.cycle_phase + (t - joint_s) / cycle.cycle_s;
-    phase[slot] = ph - std::floor(ph);
+    // The gait phase follows the transition's own steps: the cycle joins (or leaves) in step.
+    phase[slot] = tr.phase_at(t);
     st.prev_phase[slot] = phase[slot];
     // The transition's layer takes a free one (a forward-only blend fills at most two of them,
     // plus clips fading out); until one is free its weight waits at 0 (a layer dropped at once

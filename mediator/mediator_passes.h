@@ -180,10 +180,9 @@ void weights_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
 void rate_phase_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
                      std::span<const float> cadence_scale, std::span<const float> lower_yaw,
-                     std::span<const float> transition_weight,
-                     std::span<float> phase, std::span<float> idle_time_s,
-                     std::span<float> out_playback_rate, std::span<float> out_gait_weight,
-                     std::span<float> out_travel_yaw);
+                     std::span<const float> transition_weight, std::span<float> phase,
+                     std::span<float> idle_time_s, std::span<float> out_playback_rate,
+                     std::span<float> out_gait_weight, std::span<float> out_travel_yaw);
 
 // --- transitions --------------------------------------------------------------------------------
 // Per slot, carried: the start or stop clip an agent plays (LocomotionLibrary::transitions) as a
@@ -206,6 +205,9 @@ struct TransitionState {
   // Waiting: the playback rate when the stop was chosen, the cadence the weights pass holds
   // until the stop begins (0: none).
   std::span<float> min_cadence;
+  // Waiting: the agent's speed when the stop was chosen [m/s]: the stop is given up once the
+  // agent is faster again, not on a frame's rise of a speed that jitters while it slows.
+  std::span<float> chosen_speed_m_s;
   std::span<float> lag_m;  // playing: the agent's distance travelled minus the clip's [m]
   std::span<float> prev_speed_m_s, prev_phase;
   std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
@@ -222,10 +224,13 @@ inline constexpr float kStopDeceleration = 0.3f;
 // (falling below it after moving as long). In APM, with a library that has them, plays them: a
 // start as the agent starts, from the clip time where the clip moves as fast as the agent; a stop
 // once the speed falls fast enough to come to rest within the clip's own stopping time, entered
-// where the clip has slowed to the agent's speed and begun when the gait phase reaches the one
-// the stop's contacts match there. The clock runs at the agent's speed over the clip's root
-// speed, corrected so that the clip's root travels as far as the agent does (within the rate
-// limits); the gait phase follows the clock so the cycle joins in step. A start the agent does not
+// where the clip has slowed to the agent's speed or later (where the agent can still play it and
+// come to rest in time; of those, the one whose gait phase comes soonest) and begun when the
+// gait phase reaches the one the stop's contacts match there (given up once the agent is faster
+// than when it chose the stop, stands first, or the phase does not come within a cycle). The
+// clock runs at the agent's speed over the clip's root speed, corrected so that the clip's root
+// travels as far as the agent does (within the rate limits); the gait phase follows the clip's
+// own steps (Transition::phase_track) so the cycle joins in step. A start the agent does not
 // keep up with, or a stop it walks out of, fades out early. Writes the transition's layer (in a
 // free layer, the others sharing 1 - its weight), the gait share and the phase. A library without
 // transitions changes nothing.

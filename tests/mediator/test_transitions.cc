@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "mediator/mediator.h"
+#include "mediator/mediator_passes.h"
 #include "tests/mediator/mediator_fixture.h"
 #include "tests/test_data.h"
 
@@ -159,6 +160,96 @@ TEST(Transitions, AnAgentComesToRestInAStopOnEitherFoot) {
     EXPECT_LE(r.root_error_cm.mean, 3.0) << "seed " << seed;
   }
   EXPECT_EQ(played, 8);
+}
+
+// Whether clip analysis has `side` in contact at clip time t (a loop's contacts may run past its
+// end: t is tried a period on either side as well).
+bool in_contact(const LocomotionClip& c, int side, float t) {
+  const float period = c.clip.loops ? c.clip.duration_s() : 0.0f;
+  for (const TimeInterval& iv : c.analysis.contacts[side]) {
+    for (float shift : {0.0f, period, -period}) {
+      if (iv.start_s <= t + shift && t + shift <= iv.end_s) return true;
+    }
+  }
+  return false;
+}
+
+// While a transition plays, the gait phase follows its own steps (Transition::phase_track): the
+// cycle clip, at that phase, lands each foot with the transition. A stop's steps change length
+// and take another time than the cycle's, so a clock at the cycle's own rate from one landing
+// drifts off them (the jog's sudden stop: 3 of its 8 later landings, mirror image included, find
+// the cycle's foot in the air).
+TEST(Transitions, TheCycleStepsWithTheTransitionsFeet) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = test::load_data_library({"clips/bvh/more/cmu_16_11_walk_veer_left.bvh",
+                                      "clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  ASSERT_FALSE(lib->transitions.empty());
+  int landings = 0;
+  for (const Transition& tr : lib->transitions) {
+    const LocomotionClip& clip = lib->clips[tr.clip];
+    const LocomotionClip& cycle = lib->clips[tr.cycle_clip];
+    // Each landing of the transition after its first frame (its cut): the cycle at the track's
+    // phase a frame later has that foot down too.
+    for (int s = 0; s < 2; ++s) {
+      for (const TimeInterval& iv : clip.analysis.contacts[s]) {
+        if (iv.start_s < 0.5f / tr.fps) continue;
+        const float t = iv.start_s + 1.0f / tr.fps;
+        EXPECT_TRUE(in_contact(cycle, s, cycle.time_at_phase(tr.phase_at(t))))
+            << clip.clip.name << " side " << s << " landing at " << iv.start_s << " s";
+        ++landings;
+      }
+    }
+  }
+  EXPECT_GE(landings, 10);
+}
+
+// A stop once chosen waits for the gait phase its first step matches. A speed that rises for a
+// frame while the agent slows down (a DetourCrowd agent's in a jam does so all the time) is not
+// walking on: the stop is given up only once the agent is faster than when it was chosen.
+TEST(Transitions, AChosenStopIsKeptThroughASpeedBumpBelowTheSpeedItWasChosenAt) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const MediatorParams params;
+  const std::vector<int32_t> slot_of_agent{0};
+  std::vector<uint8_t> fresh{1}, standing{0};
+  const PassCrowd crowd{*lib, params, kDt, slot_of_agent, fresh};
+  std::vector<float> speed{1.1f}, rate{1.0f}, gait{1.0f}, phase{0.0f};
+  std::vector<int16_t> layer_clip(kMaxBlendLayers, static_cast<int16_t>(lib->idle));
+  std::vector<float> layer_weight(kMaxBlendLayers, 0.0f);
+  layer_clip[0] = static_cast<int16_t>(lib->transitions.front().cycle_clip);
+  layer_weight[0] = 1.0f;
+  std::vector<int16_t> index{-1};
+  std::vector<TransitionStage> stage{TransitionStage::kNone};
+  std::vector<float> time{0}, weight{0}, tr_rate{1}, waited{0}, min_cadence{0}, chosen{0}, lag{0},
+      prev_speed{0}, prev_phase{0}, still{0}, moving{0};
+  std::vector<uint32_t> counts(kNumCounts, 0);
+  const TransitionState state{index,  stage, time,       weight,     tr_rate, waited, min_cadence,
+                              chosen, lag,   prev_speed, prev_phase, still,   moving, counts};
+  // The gait phase stands still: the stop's own phase never comes, so it waits.
+  auto step = [&](float v) {
+    speed[0] = v;
+    transition_pass(crowd, speed, rate, standing, layer_clip, layer_weight, gait, phase, state);
+    fresh[0] = 0;
+  };
+  float v = 1.1f;
+  for (int f = 0; f < 30; ++f) step(v);  // walking
+  for (int f = 0; f < 60 && stage[0] != TransitionStage::kWaiting; ++f) step(v -= 1.0f * kDt);
+  ASSERT_EQ(stage[0], TransitionStage::kWaiting) << "no stop chosen when slowing at 1 m/s^2";
+  const float chosen_at = v;
+  for (int f = 0; f < 3; ++f) step(v -= 1.0f * kDt);
+  step(v += 0.6f * kDt);  // a frame's rise, still below the speed the stop was chosen at
+  EXPECT_LT(v, chosen_at);
+  EXPECT_EQ(stage[0], TransitionStage::kWaiting) << "given up for a frame's rise of the speed";
+  step(v = chosen_at + 0.05f);  // walking on, faster than it was
+  EXPECT_EQ(stage[0], TransitionStage::kNone) << "kept though the agent walks on";
 }
 
 TEST(Transitions, TheBuiltinLibraryHasNone) {
