@@ -61,6 +61,19 @@ inline Result<LocomotionLibrary> load_data_library(std::initializer_list<const c
   return build_locomotion_library(*sets);
 }
 
+// The whole CMU subject-16 set of ../shared/data/clips/bvh/more (walks, a turn, a fast walk, a
+// start, a stop, a jog and a sudden stop), as one library.
+inline Result<LocomotionLibrary> subject16_library() {
+  return load_data_library({"clips/bvh/more/cmu_16_11_walk_veer_left.bvh",
+                            "clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+                            "clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh",
+                            "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
+                            "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh",
+                            "clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh",
+                            "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh",
+                            "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh"});
+}
+
 // A headless pipeline that records the metrics (by default no palettes: nothing is drawn).
 inline PipelineOptions test_pipeline_options(size_t capacity, float frame_time_s,
                                              bool make_palettes = false,

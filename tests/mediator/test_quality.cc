@@ -130,14 +130,7 @@ TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
 // a lock let go; what holds now besides the body bounds: support slide, float and limb pops.
 TEST(Quality, CorridorWithTheSubject16Clips) {
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
-  auto lib = test::load_data_library(
-      {"clips/bvh/more/cmu_16_11_walk_veer_left.bvh", "clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
-       "clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh",
-       "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
-       "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh",
-       "clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh",
-       "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh",
-       "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh"});
+  auto lib = test::subject16_library();
   ASSERT_TRUE(lib.ok()) << lib.message();
   auto a = scenario_crowd("corridor");
   auto b = scenario_crowd("corridor");

@@ -181,14 +181,7 @@ bool in_contact(const LocomotionClip& c, int side, float t) {
 // the cycle's foot in the air).
 TEST(Transitions, TheCycleStepsWithTheTransitionsFeet) {
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
-  auto lib = test::load_data_library({"clips/bvh/more/cmu_16_11_walk_veer_left.bvh",
-                                      "clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
-                                      "clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh",
-                                      "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
-                                      "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh",
-                                      "clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh",
-                                      "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh",
-                                      "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh"});
+  auto lib = test::subject16_library();
   ASSERT_TRUE(lib.ok()) << lib.message();
   ASSERT_FALSE(lib->transitions.empty());
   int landings = 0;
