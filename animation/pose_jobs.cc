@@ -741,6 +741,273 @@ void TwoBoneIKJob::run() const {
   *out_mid_correction = mid_corr;
 }
 
+#if defined(__SSE2__)
+namespace {
+namespace pair_ik {
+
+// Three-vectors and quaternions of the two limbs, lanes (a, b, a, b): every lane glm's operations
+// on its own limb in glm's order.
+struct V3 {
+  __m128 x, y, z;
+};
+
+inline __m128 splat(float v) { return _mm_set1_ps(v); }
+inline __m128 pair(float a, float b) { return _mm_setr_ps(a, b, a, b); }
+inline V3 pair(const glm::vec3& a, const glm::vec3& b) {
+  return {pair(a.x, b.x), pair(a.y, b.y), pair(a.z, b.z)};
+}
+inline V3 sub(const V3& a, const V3& b) {
+  return {_mm_sub_ps(a.x, b.x), _mm_sub_ps(a.y, b.y), _mm_sub_ps(a.z, b.z)};
+}
+inline V3 add(const V3& a, const V3& b) {
+  return {_mm_add_ps(a.x, b.x), _mm_add_ps(a.y, b.y), _mm_add_ps(a.z, b.z)};
+}
+inline V3 scale(const V3& a, __m128 s) {
+  return {_mm_mul_ps(a.x, s), _mm_mul_ps(a.y, s), _mm_mul_ps(a.z, s)};
+}
+inline V3 divide(const V3& a, __m128 s) {  // glm's v / s: each component divided
+  return {_mm_div_ps(a.x, s), _mm_div_ps(a.y, s), _mm_div_ps(a.z, s)};
+}
+inline V3 negate(const V3& a) {
+  const __m128 sign = splat(-0.0f);
+  return {_mm_xor_ps(a.x, sign), _mm_xor_ps(a.y, sign), _mm_xor_ps(a.z, sign)};
+}
+// glm::dot: (xx + yy) + zz.
+inline __m128 dot(const V3& a, const V3& b) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(a.x, b.x), _mm_mul_ps(a.y, b.y)), _mm_mul_ps(a.z, b.z));
+}
+inline V3 cross(const V3& x, const V3& y) {
+  return {_mm_sub_ps(_mm_mul_ps(x.y, y.z), _mm_mul_ps(y.y, x.z)),
+          _mm_sub_ps(_mm_mul_ps(x.z, y.x), _mm_mul_ps(y.z, x.x)),
+          _mm_sub_ps(_mm_mul_ps(x.x, y.y), _mm_mul_ps(y.x, x.y))};
+}
+inline __m128 length(const V3& v) { return _mm_sqrt_ps(dot(v, v)); }
+// glm::normalize: v * (1 / sqrt(dot(v, v))).
+inline V3 normalize(const V3& v) { return scale(v, _mm_div_ps(splat(1.0f), length(v))); }
+// std::max(a, b) and std::min(a, b) to the bit (ties and NaN: a): maxps / minps return their
+// second operand then.
+inline __m128 std_max(__m128 a, __m128 b) { return _mm_max_ps(b, a); }
+inline __m128 std_min(__m128 a, __m128 b) { return _mm_min_ps(b, a); }
+inline __m128 select(__m128 mask, __m128 a, __m128 b) {
+  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+// std::clamp(v, lo, hi): v < lo ? lo : hi < v ? hi : v.
+inline __m128 clamp4(__m128 v, __m128 lo, __m128 hi) {
+  return select(_mm_cmplt_ps(v, lo), lo, select(_mm_cmplt_ps(hi, v), hi, v));
+}
+inline __m128 clamp_unit4(__m128 x) { return clamp4(x, splat(-1.0f), splat(1.0f)); }
+inline Quat4 select(__m128 mask, const Quat4& a, const Quat4& b) {
+  return {select(mask, a.x, b.x), select(mask, a.y, b.y), select(mask, a.z, b.z),
+          select(mask, a.w, b.w)};
+}
+inline bool any(__m128 mask) { return _mm_movemask_ps(mask) != 0; }
+
+// glm's p * q.
+inline Quat4 mul(const Quat4& p, const Quat4& q) {
+  auto m = [](__m128 a, __m128 b) { return _mm_mul_ps(a, b); };
+  return {_mm_sub_ps(_mm_add_ps(_mm_add_ps(m(p.w, q.x), m(p.x, q.w)), m(p.y, q.z)), m(p.z, q.y)),
+          _mm_sub_ps(_mm_add_ps(_mm_add_ps(m(p.w, q.y), m(p.y, q.w)), m(p.z, q.x)), m(p.x, q.z)),
+          _mm_sub_ps(_mm_add_ps(_mm_add_ps(m(p.w, q.z), m(p.z, q.w)), m(p.x, q.y)), m(p.y, q.x)),
+          _mm_sub_ps(_mm_sub_ps(_mm_sub_ps(m(p.w, q.w), m(p.x, q.x)), m(p.y, q.y)), m(p.z, q.z))};
+}
+// glm::inverse: the conjugate over dot(q, q).
+inline Quat4 inverse(const Quat4& q) {
+  const __m128 n = dot4(q, q), sign = splat(-0.0f);
+  return {_mm_div_ps(_mm_xor_ps(q.x, sign), n), _mm_div_ps(_mm_xor_ps(q.y, sign), n),
+          _mm_div_ps(_mm_xor_ps(q.z, sign), n), _mm_div_ps(q.w, n)};
+}
+// glm's q * v.
+inline V3 rotate(const Quat4& q, const V3& v) {
+  const V3 qv{q.x, q.y, q.z};
+  const V3 uv = cross(qv, v);
+  const V3 uuv = cross(qv, uv);
+  return add(v, scale(add(scale(uv, q.w), uuv), splat(2.0f)));
+}
+
+// rotation_of_cos_sin per lane; `fail` gets the lanes that would take its other branches.
+inline Quat4 rotation_of_cos_sin(__m128 c, __m128 s, const V3& axis, __m128& fail) {
+  const __m128 r = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(c, c), _mm_mul_ps(s, s)));
+  const __m128 rc = _mm_add_ps(r, c);
+  fail = _mm_or_ps(_mm_cmpngt_ps(r, _mm_setzero_ps()),
+                   _mm_cmplt_ps(rc, _mm_mul_ps(splat(1e-3f), r)));
+  return normalize4({_mm_mul_ps(s, axis.x), _mm_mul_ps(s, axis.y), _mm_mul_ps(s, axis.z), rc});
+}
+
+// rotation_by_acos_difference per lane.
+inline Quat4 rotation_by_acos_difference(__m128 c1, __m128 c0, const V3& axis) {
+  const __m128 half = splat(0.5f), one = splat(1.0f), zero = _mm_setzero_ps();
+  auto half_cos = [&](__m128 c) {
+    return _mm_sqrt_ps(std_max(zero, _mm_mul_ps(half, _mm_add_ps(one, c))));
+  };
+  auto half_sin = [&](__m128 c) {
+    return _mm_sqrt_ps(std_max(zero, _mm_mul_ps(half, _mm_sub_ps(one, c))));
+  };
+  const __m128 h1c = half_cos(c1), h1s = half_sin(c1), h0c = half_cos(c0), h0s = half_sin(c0);
+  const __m128 cw = _mm_add_ps(_mm_mul_ps(h1c, h0c), _mm_mul_ps(h1s, h0s));
+  const __m128 sw = _mm_sub_ps(_mm_mul_ps(h1s, h0c), _mm_mul_ps(h1c, h0s));
+  return {_mm_mul_ps(sw, axis.x), _mm_mul_ps(sw, axis.y), _mm_mul_ps(sw, axis.z), cw};
+}
+
+// rotation_between per lane; `fail` gets the lanes of its degenerate branches.
+inline Quat4 rotation_between(V3 from, V3 to, __m128& fail) {
+  const __m128 lf = length(from), lt = length(to);
+  const __m128 tiny = splat(1e-8f);
+  fail = _mm_or_ps(_mm_cmplt_ps(lf, tiny), _mm_cmplt_ps(lt, tiny));
+  from = divide(from, lf);
+  to = divide(to, lt);
+  const __m128 d = clamp_unit4(dot(from, to));
+  const V3 axis = cross(from, to);
+  const __m128 axis_len = length(axis);
+  fail = _mm_or_ps(fail, _mm_cmplt_ps(axis_len, splat(1e-7f)));
+  __m128 fail_cs;
+  const Quat4 q = rotation_of_cos_sin(d, axis_len, divide(axis, axis_len), fail_cs);
+  fail = _mm_or_ps(fail, fail_cs);
+  return q;
+}
+
+// glm::quat_cast of four matrices' rotations (one per lane), its branches as selects.
+inline Quat4 quat_cast4(const glm::mat4& m0, const glm::mat4& m1, const glm::mat4& m2,
+                        const glm::mat4& m3) {
+  __m128 col[3][4];
+  for (int c = 0; c < 3; ++c) {
+    col[c][0] = _mm_loadu_ps(&m0[c].x);
+    col[c][1] = _mm_loadu_ps(&m1[c].x);
+    col[c][2] = _mm_loadu_ps(&m2[c].x);
+    col[c][3] = _mm_loadu_ps(&m3[c].x);
+    _MM_TRANSPOSE4_PS(col[c][0], col[c][1], col[c][2], col[c][3]);  // col[c][r]: m[c][r]
+  }
+  auto m = [&](int c, int r) { return col[c][r]; };
+  const __m128 fx = _mm_sub_ps(_mm_sub_ps(m(0, 0), m(1, 1)), m(2, 2));
+  const __m128 fy = _mm_sub_ps(_mm_sub_ps(m(1, 1), m(0, 0)), m(2, 2));
+  const __m128 fz = _mm_sub_ps(_mm_sub_ps(m(2, 2), m(0, 0)), m(1, 1));
+  const __m128 fw = _mm_add_ps(_mm_add_ps(m(0, 0), m(1, 1)), m(2, 2));
+  const __m128 is_x = _mm_cmpgt_ps(fx, fw);
+  __m128 big = select(is_x, fx, fw);
+  const __m128 is_y = _mm_cmpgt_ps(fy, big);
+  big = select(is_y, fy, big);
+  const __m128 is_z = _mm_cmpgt_ps(fz, big);
+  big = select(is_z, fz, big);
+  const __m128 bv = _mm_mul_ps(_mm_sqrt_ps(_mm_add_ps(big, splat(1.0f))), splat(0.5f));
+  const __m128 mult = _mm_div_ps(splat(0.25f), bv);
+  const __m128 A = _mm_mul_ps(_mm_sub_ps(m(1, 2), m(2, 1)), mult);
+  const __m128 B = _mm_mul_ps(_mm_sub_ps(m(2, 0), m(0, 2)), mult);
+  const __m128 C = _mm_mul_ps(_mm_sub_ps(m(0, 1), m(1, 0)), mult);
+  const __m128 D = _mm_mul_ps(_mm_add_ps(m(0, 1), m(1, 0)), mult);
+  const __m128 E = _mm_mul_ps(_mm_add_ps(m(2, 0), m(0, 2)), mult);
+  const __m128 F = _mm_mul_ps(_mm_add_ps(m(1, 2), m(2, 1)), mult);
+  Quat4 q{A, B, C, bv};                      // w largest
+  q = select(is_x, Quat4{bv, D, E, A}, q);  // x
+  q = select(is_y, Quat4{D, bv, F, B}, q);  // y
+  q = select(is_z, Quat4{E, F, bv, C}, q);  // z
+  return q;
+}
+
+}  // namespace pair_ik
+}  // namespace
+#endif
+
+void two_bone_ik_pair(const TwoBoneIKJob& ja, const TwoBoneIKJob& jb) {
+#if defined(__SSE2__)
+  using namespace pair_ik;
+  auto one_by_one = [&] {
+    ja.run();
+    jb.run();
+  };
+  if (ja.out_reached || jb.out_reached || !(ja.weight == 1.0f) || !(jb.weight == 1.0f)) {
+    return one_by_one();
+  }
+  const V3 a = pair(translation_of(ja.start_model), translation_of(jb.start_model));
+  const V3 b = pair(translation_of(ja.mid_model), translation_of(jb.mid_model));
+  const V3 c = pair(translation_of(ja.end_model), translation_of(jb.end_model));
+  const V3 target = pair(ja.target, jb.target);
+  const V3 pole = pair(ja.pole, jb.pole);
+  const V3 ba = sub(b, a), cb = sub(c, b);
+  const __m128 lab = length(ba), lcb = length(cb);
+  if (any(_mm_or_ps(_mm_cmplt_ps(lab, splat(1e-6f)), _mm_cmplt_ps(lcb, splat(1e-6f))))) {
+    return one_by_one();
+  }
+  const V3 ta = sub(target, a);
+  const __m128 reach = length(ta);
+  const __m128 max_len =
+      _mm_mul_ps(_mm_add_ps(lab, lcb), pair(ja.max_extension, jb.max_extension));
+  const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  const __m128 min_len = _mm_add_ps(_mm_and_ps(_mm_sub_ps(lab, lcb), abs_mask), splat(1e-4f));
+  const V3 ac = sub(c, a);
+  const __m128 lac = length(ac);
+  const __m128 soften =
+      pair(std::clamp(ja.soften, 0.0f, 1.0f), std::clamp(jb.soften, 0.0f, 1.0f));
+  const __m128 soft_start = std_max(_mm_mul_ps(max_len, soften), std_min(lac, max_len));
+  const __m128 soft_span = _mm_sub_ps(max_len, soft_start);
+  __m128 soft_reach = reach;
+  const int soft = _mm_movemask_ps(_mm_and_ps(_mm_cmpgt_ps(soft_span, splat(1e-6f)),
+                                              _mm_cmpgt_ps(reach, soft_start)));
+  if (soft & 3) {  // the exp per lane, by the scalar code's own expression
+    alignas(16) float st[4], sp[4], re[4];
+    _mm_store_ps(st, soft_start);
+    _mm_store_ps(sp, soft_span);
+    _mm_store_ps(re, reach);
+    for (int k = 0; k < 2; ++k) {
+      if (soft & (1 << k)) re[k] = st[k] + sp[k] * (1.0f - std::exp(-(re[k] - st[k]) / sp[k]));
+    }
+    soft_reach = pair(re[0], re[1]);
+  }
+  const __m128 lat = clamp4(soft_reach, min_len, std_max(min_len, max_len));
+  const V3 ab = normalize(ba), bc = normalize(cb);
+  if (any(_mm_cmplt_ps(lac, splat(1e-6f)))) return one_by_one();
+  const V3 ac_n = divide(ac, lac);
+  const __m128 cos_hip_0 = clamp_unit4(dot(ac_n, ab));
+  const __m128 cos_knee_0 = clamp_unit4(dot(negate(ab), bc));
+  const __m128 lab2 = _mm_mul_ps(lab, lab), lcb2 = _mm_mul_ps(lcb, lcb), lat2 = _mm_mul_ps(lat, lat);
+  const __m128 m2lab = _mm_mul_ps(splat(-2.0f), lab);
+  const __m128 cos_hip_1 =
+      clamp_unit4(_mm_div_ps(_mm_sub_ps(_mm_sub_ps(lcb2, lab2), lat2), _mm_mul_ps(m2lab, lat)));
+  const __m128 cos_knee_1 =
+      clamp_unit4(_mm_div_ps(_mm_sub_ps(_mm_sub_ps(lat2, lab2), lcb2), _mm_mul_ps(m2lab, lcb)));
+  // A limb near straight bends in the pole's plane (acos of its angles): one by one.
+  V3 axis0 = cross(ac_n, ab);
+  const __m128 own = length(axis0);
+  const V3 pole_axis = cross(ac_n, pole);
+  if (any(_mm_and_ps(_mm_cmplt_ps(own, splat(kStraightLimb)),
+                     _mm_cmpge_ps(length(pole_axis), splat(1e-5f)))) ||
+      any(_mm_cmplt_ps(own, splat(1e-5f)))) {
+    return one_by_one();
+  }
+  axis0 = normalize(axis0);
+  const Quat4 r_bend = rotation_by_acos_difference(cos_hip_1, cos_hip_0, axis0);
+  const Quat4 r_knee = rotation_by_acos_difference(cos_knee_1, cos_knee_0, axis0);
+  const V3 c1 = add(add(a, rotate(r_bend, ba)), rotate(r_bend, rotate(r_knee, cb)));
+  __m128 fail;
+  const Quat4 r_swing = rotation_between(sub(c1, a), ta, fail);
+  if (any(fail)) return one_by_one();
+  Quat4 r = mul(r_swing, r_bend);
+  const V3 axis_t = normalize(ta);
+  const V3 knee = rotate(r, ba);
+  const V3 knee_p = sub(knee, scale(axis_t, dot(knee, axis_t)));
+  const V3 pole_p = sub(pole, scale(axis_t, dot(pole, axis_t)));
+  const __m128 twist = _mm_and_ps(_mm_cmpgt_ps(length(knee_p), splat(1e-5f)),
+                                  _mm_cmpgt_ps(length(pole_p), splat(1e-5f)));
+  if (any(twist)) {
+    const Quat4 t =
+        rotation_of_cos_sin(dot(knee_p, pole_p), dot(cross(knee_p, pole_p), axis_t), axis_t, fail);
+    if (any(_mm_and_ps(fail, twist))) return one_by_one();
+    r = select(twist, mul(t, r), r);
+  }
+  // Lanes (a start, b start, a mid, b mid): conjugate_into of r and r_knee.
+  const Quat4 q = quat_cast4(ja.start_model, jb.start_model, ja.mid_model, jb.mid_model);
+  const __m128 mid_lanes = _mm_castsi128_ps(_mm_setr_epi32(0, 0, -1, -1));
+  const Quat4 rr = select(mid_lanes, r_knee, r);
+  glm::quat out[4];
+  store4(normalize4(mul(mul(inverse(q), rr), q)), out);
+  *ja.out_start_correction = out[0];
+  *jb.out_start_correction = out[1];
+  *ja.out_mid_correction = out[2];
+  *jb.out_mid_correction = out[3];
+#else
+  ja.run();
+  jb.run();
+#endif
+}
+
 bool SkinningPaletteJob::validate() const {
   return model.size() == inverse_bind.size() && out_palette.size() >= model.size() &&
          (out_model_copy.empty() || out_model_copy.size() >= model.size());

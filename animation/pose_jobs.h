@@ -123,6 +123,13 @@ struct TwoBoneIKJob {
   void run() const;
 };
 
+// Two limbs' TwoBoneIKJobs at once (a body's two legs), each job's operations in its order on SSE
+// lanes: the same corrections, to the bit, as a.run() and b.run() (sqrt and division are
+// correctly rounded in either form; exp is taken per lane by the same function). Rare cases (a
+// limb straighter than 2 deg, degenerate lengths, a rotation near half a turn, a weight below 1,
+// an out_reached asked for) run the jobs one by one. Without SSE2: a.run(); b.run().
+void two_bone_ik_pair(const TwoBoneIKJob& a, const TwoBoneIKJob& b);
+
 // Skinning matrices: out[j] = model[j] * inverse_bind[j]. Affine inverse binds (bottom row
 // 0 0 0 1, as every rig's) take the cheaper affine product; affine_inverse_bind tells which
 // (is_affine(inverse_bind) once per rig; false always gives the full product).

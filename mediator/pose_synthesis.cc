@@ -731,6 +731,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     if (use_ik[side]) ankle_world_rot[side] = rotation_of(world[ankle]);
   }
   if (!use_ik[0] && !use_ik[1]) return;
+  TwoBoneIKJob ik[2];
+  glm::quat c_hip[2], c_knee[2];
   for (int side = 0; side < 2; ++side) {
     if (!use_ik[side]) continue;
     const Side sd = static_cast<Side>(side);
@@ -804,20 +806,29 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const glm::vec3 axis = glm::normalize(anim_ankle - hip_p);
     glm::vec3 pole = (knee_p - hip_p) - axis * glm::dot(knee_p - hip_p, axis);
     if (glm::length(pole) < 1e-4f) pole = glm::vec3(root[2]);
-    glm::quat c_hip, c_knee;
-    TwoBoneIKJob ik;
-    ik.start_model = world[hip];
-    ik.mid_model = world[knee];
-    ik.end_model = world[ankle];
-    ik.target = goal_ankle;
-    ik.pole = pole;
-    ik.soften = kIkSoften;
-    ik.max_extension = kIkMaxExtension;
-    ik.out_start_correction = &c_hip;
-    ik.out_mid_correction = &c_knee;
-    ik.run();
-    rot[hip] = normalized_product(rot[hip], c_hip);
-    rot[knee] = normalized_product(rot[knee], c_knee);
+    // Both legs' IK in one pass (the legs' world joints stay as posed until fk_list below).
+    TwoBoneIKJob& job = ik[side];
+    job.start_model = world[hip];
+    job.mid_model = world[knee];
+    job.end_model = world[ankle];
+    job.target = goal_ankle;
+    job.pole = pole;
+    job.soften = kIkSoften;
+    job.max_extension = kIkMaxExtension;
+    job.out_start_correction = &c_hip[side];
+    job.out_mid_correction = &c_knee[side];
+  }
+  if (use_ik[0] && use_ik[1]) {
+    two_bone_ik_pair(ik[0], ik[1]);
+  } else {
+    ik[use_ik[0] ? 0 : 1].run();
+  }
+  for (int side = 0; side < 2; ++side) {
+    if (!use_ik[side]) continue;
+    const Side sd = static_cast<Side>(side);
+    const int hip = skeleton_.hip(sd), knee = skeleton_.knee(sd);
+    rot[hip] = normalized_product(rot[hip], c_hip[side]);
+    rot[knee] = normalized_product(rot[knee], c_knee[side]);
   }
   const int ik_sides = (use_ik[0] ? 1 : 0) | (use_ik[1] ? 2 : 0);
   fk_list(world, rot, trans, leg_fk_[ik_sides], placed);

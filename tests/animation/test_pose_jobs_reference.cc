@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -190,6 +191,58 @@ TEST(TwoBoneIKJobReference, KneeOppositeThePoleTurnsHalfAround) {
   EXPECT_LT(angle_between(c1, ref.mid_correction), 1e-3f);
   // The knee really turned: the correction is about half a turn about the hip-target axis.
   EXPECT_GT(angle_between(c0, glm::quat(1, 0, 0, 0)), 3.0f);
+}
+
+// Both legs at once on SSE lanes: each leg's corrections the same bits as its job's own run(),
+// over hips turned every way (every branch of quat_cast), bends from straight (the pole-plane
+// band, run one by one) to deep, targets from close in to past full reach (the soft exp per lane)
+// and poles across and opposite the knee (a twist near half a turn, one by one).
+TEST(TwoBoneIKPair, SameBitsAsEachJobAlone) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f);
+  auto make = [&](int trial) {
+    const float bend = trial % 5 == 0 ? 0.05f * u01(rng) : 1.5f * u01(rng);
+    std::vector<glm::mat4> m = random_leg(rng, 0.4f + 0.1f * u01(rng), 0.4f + 0.1f * u01(rng), bend);
+    // Any world orientation of the whole leg (random_leg turns its hip by at most ~45 deg).
+    glm::mat4 turn = glm::mat4_cast(glm::normalize(glm::quat(u(rng), u(rng), u(rng), u(rng))));
+    turn[3] = glm::vec4(u(rng), u(rng), u(rng), 1.0f);
+    if (trial % 3 != 0) {
+      for (glm::mat4& j : m) j = turn * j;
+    }
+    const glm::vec3 hip = translation_of(m[0]), ankle = translation_of(m[2]);
+    const glm::vec3 dir = glm::normalize(ankle - hip + 0.5f * glm::vec3(u(rng), u(rng), u(rng)));
+    TwoBoneIKJob job;
+    job.start_model = m[0];
+    job.mid_model = m[1];
+    job.end_model = m[2];
+    job.target = hip + dir * (0.05f + 1.0f * u01(rng));
+    job.pole = trial % 7 == 0 ? -(translation_of(m[1]) - hip)
+                              : glm::normalize(glm::vec3(u(rng), 0.3f * u(rng), 1.0f));
+    job.soften = trial % 2 == 0 ? 0.98f : 1.0f;
+    job.max_extension = trial % 4 == 0 ? 1.0f : 0.999f;
+    return job;
+  };
+  auto same = [](const glm::quat& p, const glm::quat& q) {
+    return std::memcmp(&p, &q, sizeof(glm::quat)) == 0;
+  };
+  int differing = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    TwoBoneIKJob ja = make(trial), jb = make(trial / 2);
+    glm::quat a0, a1, b0, b1, ra0, ra1, rb0, rb1;
+    ja.out_start_correction = &ra0;
+    ja.out_mid_correction = &ra1;
+    jb.out_start_correction = &rb0;
+    jb.out_mid_correction = &rb1;
+    ja.run();
+    jb.run();
+    ja.out_start_correction = &a0;
+    ja.out_mid_correction = &a1;
+    jb.out_start_correction = &b0;
+    jb.out_mid_correction = &b1;
+    two_bone_ik_pair(ja, jb);
+    if (!same(a0, ra0) || !same(a1, ra1) || !same(b0, rb0) || !same(b1, rb1)) ++differing;
+  }
+  EXPECT_EQ(differing, 0);
 }
 
 TEST(MinAbsDot, SameAsTheScalarLoop) {
