@@ -183,11 +183,20 @@ bool valid_joint_list(std::span<const int16_t> joints, size_t n) {
 
 }  // namespace
 
+bool valid_runs(std::span<const JointRun> runs, size_t n) {
+  int last = 0;
+  for (const JointRun& r : runs) {
+    if (r.from < last || r.to <= r.from || static_cast<size_t>(r.to) > n) return false;
+    last = r.to;
+  }
+  return true;
+}
+
 bool SampleClipJob::validate() const {
   if (!clip || clip->num_frames <= 0 || clip->fps <= 0.0f) return false;
   const size_t n = static_cast<size_t>(clip->num_joints);
   return out_rotations.size() >= n && out_translations.size() >= n &&
-         valid_joint_list(translated_joints, n) &&
+         valid_joint_list(translated_joints, n) && valid_runs(sampled_runs, n) &&
          clip->rotations.size() == n * clip->num_frames &&
          clip->translations.size() == n * clip->num_frames && std::isfinite(time_s);
 }
@@ -277,6 +286,7 @@ struct Tail4 {
 }  // namespace
 
 void SampleClipJob::run() const {
+  if (!sampled_runs.empty()) return run_runs();
   const int n = clip->num_joints;
   const FramePair fp = frame_pair(*clip, time_s);
   const float t = fp.t;
@@ -318,13 +328,70 @@ void SampleClipJob::run() const {
   if (crosses_wrap(*clip, fp)) out_translations[0] += wrap_step(*clip, fp);
 }
 
+void SampleClipJob::run_runs() const {
+  const int n = clip->num_joints;
+  const FramePair fp = frame_pair(*clip, time_s);
+  const float t = fp.t;
+  const glm::quat* r0 = clip->frame_rotations(fp.i0);
+  const glm::quat* r1 = clip->frame_rotations(fp.i1);
+  const glm::vec3* p0 = clip->frame_translations(fp.i0);
+  const glm::vec3* p1 = clip->frame_translations(fp.i1);
+  prefetch_frames(*clip, fp, translated_joints);
+#if defined(__SSE2__)
+  const __m128 s4 = _mm_set1_ps(1.0f - t), t4 = _mm_set1_ps(t);
+#endif
+  auto rotations = [&](const int from, const int to) __attribute__((always_inline)) {
+    int j = from;
+#if defined(__SSE2__)
+    for (; j + 4 <= to; j += 4) store4(sample4(r0 + j, r1 + j, s4, t4), out_rotations.data() + j);
+    if (j < to && to - from >= 4) {
+      // The last four joints again (each lane's arithmetic is its own: the ones done already
+      // come out the same), rather than the rest padded through a copy.
+      store4(sample4(r0 + to - 4, r1 + to - 4, s4, t4), out_rotations.data() + to - 4);
+      j = to;
+    }
+    if (j < to) {
+      const Tail4 a(r0 + j, to - j), b(r1 + j, to - j);
+      glm::quat out[4];
+      store4(sample4(a.q, b.q, s4, t4), out);
+      std::copy_n(out, to - j, out_rotations.data() + j);
+      j = to;
+    }
+#endif
+    for (; j < to; ++j) out_rotations[j] = nlerp_shortest(r0[j], r1[j], t);
+  };
+  const JointRun every{0, n};
+  const std::span<const JointRun> runs =
+      sampled_runs.empty() ? std::span<const JointRun>(&every, 1) : sampled_runs;
+  for (const JointRun& r : runs) rotations(r.from, r.to);
+  if (!translated_joints.empty()) {  // the listed joints only, with weighted_floats' arithmetic
+    for (const int16_t k : translated_joints) {
+      out_translations[k] = weighted_vec3(p0[k], 1.0f - t, p1[k], t);
+    }
+    if (translated_joints.front() == 0 && crosses_wrap(*clip, fp)) {
+      out_translations[0] += wrap_step(*clip, fp);
+    }
+    return;
+  }
+  auto translations = [&](const int from, const int to) __attribute__((always_inline)) {
+    weighted_floats(reinterpret_cast<const float*>(p0 + from), 1.0f - t,
+                    reinterpret_cast<const float*>(p1 + from), t, 3 * static_cast<size_t>(to - from),
+                    reinterpret_cast<float*>(out_translations.data() + from));
+  };
+  for (const JointRun& r : runs) translations(r.from, r.to);
+  if (runs.front().from == 0 && crosses_wrap(*clip, fp)) {
+    out_translations[0] += wrap_step(*clip, fp);
+  }
+}
+
 bool SampleBlendJob::validate() const {
   if (!a.clip || !b.clip || a.clip->num_joints != b.clip->num_joints) return false;
   if (!(a.weight > 0.0f) || !(b.weight > 0.0f) || !std::isfinite(a.weight + b.weight)) {
     return false;
   }
   for (const Input* in : {&a, &b}) {
-    if (!SampleClipJob{in->clip, in->time_s, out_rotations, out_translations, translated_joints}
+    if (!SampleClipJob{in->clip, in->time_s, out_rotations, out_translations, translated_joints,
+                       sampled_runs}
              .validate()) {
       return false;
     }
@@ -333,6 +400,7 @@ bool SampleBlendJob::validate() const {
 }
 
 void SampleBlendJob::run() const {
+  if (!sampled_runs.empty()) return run_runs();
   const int n = a.clip->num_joints;
   const FramePair fa = frame_pair(*a.clip, a.time_s), fb = frame_pair(*b.clip, b.time_s);
   prefetch_frames(*a.clip, fa, translated_joints);
@@ -431,6 +499,124 @@ void SampleBlendJob::run() const {
     const float la = a0[i] * (1.0f - fa.t) + a1[i] * fa.t;
     const float lb = b0[i] * (1.0f - fb.t) + b1[i] * fb.t;
     out[i] = la * wa + lb * wb;
+  }
+}
+
+void SampleBlendJob::run_runs() const {
+  const int n = a.clip->num_joints;
+  const FramePair fa = frame_pair(*a.clip, a.time_s), fb = frame_pair(*b.clip, b.time_s);
+  prefetch_frames(*a.clip, fa, translated_joints);
+  prefetch_frames(*b.clip, fb, translated_joints);
+  // BlendPosesJob's weights: each over their sum.
+  const float inv_total = 1.0f / (a.weight + b.weight);
+  const float wa = a.weight * inv_total, wb = b.weight * inv_total;
+  const glm::quat* a0r = a.clip->frame_rotations(fa.i0);
+  const glm::quat* a1r = a.clip->frame_rotations(fa.i1);
+  const glm::quat* b0r = b.clip->frame_rotations(fb.i0);
+  const glm::quat* b1r = b.clip->frame_rotations(fb.i1);
+#if defined(__SSE2__)
+  const __m128 sa = _mm_set1_ps(1.0f - fa.t), ta = _mm_set1_ps(fa.t);
+  const __m128 sb = _mm_set1_ps(1.0f - fb.t), tb = _mm_set1_ps(fb.t);
+  const __m128 wa4 = _mm_set1_ps(wa), wb4 = _mm_set1_ps(wb);
+  // Inlined (a call would pass the sampled rotations through memory).
+  auto blend4 = [&](const glm::quat* ra0, const glm::quat* ra1, const glm::quat* rb0,
+                    const glm::quat* rb1, glm::quat* out) __attribute__((always_inline)) {
+    const Quat4 qa = sample4(ra0, ra1, sa, ta), qb = sample4(rb0, rb1, sb, tb);
+    const __m128 negate = _mm_cmplt_ps(dot4(qa, qb), _mm_setzero_ps());
+    store4(normalize4(weighted_sum4(qa, wa4, qb, wb4, negate)), out);
+  };
+#endif
+  auto rotations = [&](const int from, const int to) __attribute__((always_inline)) {
+    int j = from;
+#if defined(__SSE2__)
+    for (; j + 4 <= to; j += 4) {
+      blend4(a0r + j, a1r + j, b0r + j, b1r + j, out_rotations.data() + j);
+    }
+    if (j < to && to - from >= 4) {  // the last four again, as SampleClipJob's
+      const int k = to - 4;
+      blend4(a0r + k, a1r + k, b0r + k, b1r + k, out_rotations.data() + k);
+      j = to;
+    }
+    if (j < to) {  // the rest padded to four (as the loop below, but for the sign of a zero)
+      const Tail4 ta0(a0r + j, to - j), ta1(a1r + j, to - j), tb0(b0r + j, to - j),
+          tb1(b1r + j, to - j);
+      glm::quat out[4];
+      blend4(ta0.q, ta1.q, tb0.q, tb1.q, out);
+      std::copy_n(out, to - j, out_rotations.data() + j);
+      j = to;
+    }
+#endif
+    for (; j < to; ++j) {  // BlendPosesJob's loop over the joints its SIMD loop leaves
+      const glm::quat qa = nlerp_shortest(a0r[j], a1r[j], fa.t);
+      const glm::quat qb = nlerp_shortest(b0r[j], b1r[j], fb.t);
+      glm::quat q(0, 0, 0, 0);
+      q += wa * qa;
+      q += (glm::dot(qa, qb) < 0.0f ? -wb : wb) * qb;
+      out_rotations[j] = glm::normalize(q);
+    }
+  };
+  const JointRun every{0, n};
+  const std::span<const JointRun> runs =
+      sampled_runs.empty() ? std::span<const JointRun>(&every, 1) : sampled_runs;
+  for (const JointRun& r : runs) rotations(r.from, r.to);
+  // Translations: each clip's lerp (its root moved on across a wrap), then the weighted mean.
+  const float* a0 = reinterpret_cast<const float*>(a.clip->frame_translations(fa.i0));
+  const float* a1 = reinterpret_cast<const float*>(a.clip->frame_translations(fa.i1));
+  const float* b0 = reinterpret_cast<const float*>(b.clip->frame_translations(fb.i0));
+  const float* b1 = reinterpret_cast<const float*>(b.clip->frame_translations(fb.i1));
+  float* out = reinterpret_cast<float*>(out_translations.data());
+  if (!translated_joints.empty()) {  // the listed joints only, with the loops' arithmetic below
+    for (const int16_t k : translated_joints) {
+      if (k == 0) continue;  // the root below, with the wraps
+      const float* pa0 = a0 + 3 * k;
+      const float* pa1 = a1 + 3 * k;
+      const float* pb0 = b0 + 3 * k;
+      const float* pb1 = b1 + 3 * k;
+      for (int c = 0; c < 3; ++c) {
+        const float la = pa0[c] * (1.0f - fa.t) + pa1[c] * fa.t;
+        const float lb = pb0[c] * (1.0f - fb.t) + pb1[c] * fb.t;
+        out[3 * k + c] = la * wa + lb * wb;
+      }
+    }
+  }
+  const bool listed = !translated_joints.empty();
+  const bool root_sampled = runs.front().from == 0;
+  if (root_sampled && (!listed || translated_joints.front() == 0)) {  // with the wraps
+    glm::vec3 ra(a0[0] * (1.0f - fa.t) + a1[0] * fa.t, a0[1] * (1.0f - fa.t) + a1[1] * fa.t,
+                 a0[2] * (1.0f - fa.t) + a1[2] * fa.t);
+    glm::vec3 rb(b0[0] * (1.0f - fb.t) + b1[0] * fb.t, b0[1] * (1.0f - fb.t) + b1[1] * fb.t,
+                 b0[2] * (1.0f - fb.t) + b1[2] * fb.t);
+    if (crosses_wrap(*a.clip, fa)) ra += wrap_step(*a.clip, fa);
+    if (crosses_wrap(*b.clip, fb)) rb += wrap_step(*b.clip, fb);
+    out_translations[0] = glm::vec3(ra.x * wa + rb.x * wb, ra.y * wa + rb.y * wb,
+                                    ra.z * wa + rb.z * wb);
+  }
+  if (listed) return;  // the listed joints are done
+#if defined(__SSE2__)
+  const __m128 sa1 = _mm_set1_ps(1.0f - fa.t), ta1 = _mm_set1_ps(fa.t);
+  const __m128 sb1 = _mm_set1_ps(1.0f - fb.t), tb1 = _mm_set1_ps(fb.t);
+  const __m128 wa1 = _mm_set1_ps(wa), wb1 = _mm_set1_ps(wb);
+#endif
+  // Floats [from, end) (the root's, 0-2, done above).
+  auto translations = [&](size_t i, const size_t end) __attribute__((always_inline)) {
+#if defined(__SSE2__)
+    for (; i + 4 <= end; i += 4) {
+      const __m128 la = _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(a0 + i), sa1),
+                                   _mm_mul_ps(_mm_loadu_ps(a1 + i), ta1));
+      const __m128 lb = _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(b0 + i), sb1),
+                                   _mm_mul_ps(_mm_loadu_ps(b1 + i), tb1));
+      _mm_storeu_ps(out + i, _mm_add_ps(_mm_mul_ps(la, wa1), _mm_mul_ps(lb, wb1)));
+    }
+#endif
+    for (; i < end; ++i) {
+      const float la = a0[i] * (1.0f - fa.t) + a1[i] * fa.t;
+      const float lb = b0[i] * (1.0f - fb.t) + b1[i] * fb.t;
+      out[i] = la * wa + lb * wb;
+    }
+  };
+  for (const JointRun& r : runs) {
+    translations(std::max<size_t>(3, 3 * static_cast<size_t>(r.from)),
+                 3 * static_cast<size_t>(r.to));
   }
 }
 

@@ -14,6 +14,11 @@
 
 namespace gk {
 
+// Joints [from, to) of a skeleton.
+struct JointRun {
+  int from = 0, to = 0;
+};
+
 // Samples a clip at time_s with linear interpolation of translations and normalised lerp of
 // rotations (shortest arc). Looping clips wrap time; others clamp it to [0, duration]. Between the
 // last frame of a loop and its first, the root joint (joint 0) keeps its mean horizontal velocity
@@ -29,8 +34,16 @@ struct SampleClipJob {
   // frame of every clip (a BVH's offsets): the caller keeps that value there once, and a lerp or
   // blend of it per agent would only round it.
   std::span<const int16_t> translated_joints;
+  // Non-empty: only the joints of these runs (ascending, apart, within the skeleton) are sampled
+  // and written, rotations and translations (of those, with translated_joints, only the listed
+  // ones' translations); the others are left as they are. For joints no clip moves (a rig's
+  // fingers): the caller keeps their pose there once.
+  std::span<const JointRun> sampled_runs;
   bool validate() const;
   void run() const;
+
+ private:
+  void run_runs() const;  // run() with sampled_runs (its own loops: every joint's stay as tuned)
 };
 
 // Two clips sampled and blended (weights normalised) straight into the output: the same numbers
@@ -51,8 +64,16 @@ struct SampleBlendJob {
   // frame of every clip (a BVH's offsets): the caller keeps that value there once, and a lerp or
   // blend of it per agent would only round it.
   std::span<const int16_t> translated_joints;
+  // Non-empty: only the joints of these runs (ascending, apart, within the skeleton) are sampled
+  // and written, rotations and translations (of those, with translated_joints, only the listed
+  // ones' translations); the others are left as they are. For joints no clip moves (a rig's
+  // fingers): the caller keeps their pose there once.
+  std::span<const JointRun> sampled_runs;
   bool validate() const;
   void run() const;
+
+ private:
+  void run_runs() const;  // run() with sampled_runs (its own loops: every joint's stay as tuned)
 };
 
 // One input of a blend: a local pose and its weight (weights need not sum to 1; they are

@@ -153,20 +153,79 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
     if (2 * translated_joints_.size() > J) translated_joints_.clear();  // all, four-wide
     if (translated_joints_.empty()) fixed_trans.assign(J, glm::vec3(0.0f));
   }
+  // Whole subtrees no clip moves (every frame's rotation and translation within kStill of the
+  // first clip's first frame: export noise, as the mannequin's fingers carry) and of which the pose
+  // stage reads nothing (no role joint, no spine joint) keep that pose: it is set in each thread's
+  // scratch once and those joints are not sampled per agent. Only when they are many (a quarter
+  // of the joints): a few would cost more in runs than they save.
+  std::vector<glm::quat> fixed_rot(J, glm::quat(1, 0, 0, 0));
+  if (clips_fit) {
+    constexpr float kStill = 1e-5f;
+    const Clip& first = library.clips.front().clip;
+    std::vector<uint8_t> still(J, 1), read(J, 0);
+    for (size_t j = 0; j < J; ++j) {
+      const glm::quat q0 = first.frame_rotations(0)[j];
+      const glm::vec3 v0 = first.frame_translations(0)[j];
+      for (const LocomotionClip& lc : library.clips) {
+        for (int f = 0; still[j] && f < lc.clip.num_frames; ++f) {
+          glm::quat q = lc.clip.frame_rotations(f)[j];
+          if (glm::dot(q, q0) < 0.0f) q = -q;
+          const glm::vec4 dq(q.x - q0.x, q.y - q0.y, q.z - q0.z, q.w - q0.w);
+          const glm::vec3 dv = lc.clip.frame_translations(f)[j] - v0;
+          still[j] = glm::all(glm::lessThanEqual(glm::abs(dq), glm::vec4(kStill))) &&
+                     glm::all(glm::lessThanEqual(glm::abs(dv), glm::vec3(kStill)));
+        }
+      }
+    }
+    for (int r = 0; r < kNumJointRoles; ++r) {
+      const int j = skeleton_.role(static_cast<JointRole>(r));
+      if (j >= 0 && j < num_joints_) read[j] = 1;
+    }
+    for (int16_t j : skeleton_.spine_chain) read[j] = 1;
+    const auto ends = subtree_ends(skeleton_);
+    std::vector<uint8_t> fixed(J, 0);
+    size_t num_fixed = 0;
+    for (int j = 1; j < num_joints_; ++j) {
+      if (fixed[skeleton_.parents[j]]) {  // inside a fixed subtree
+        fixed[j] = 1;
+      } else {
+        bool all = true;
+        for (int k = j; all && k < ends[j]; ++k) all = still[k] && !read[k];
+        fixed[j] = all;
+      }
+      num_fixed += fixed[j];
+    }
+    if (4 * num_fixed >= J) {
+      fixed_rot_.assign(J, glm::quat(1, 0, 0, 0));
+      fixed_trans_.assign(J, glm::vec3(0.0f));
+      for (int j = 0; j < num_joints_; ++j) {
+        std::vector<JointRun>& runs = fixed[j] ? fixed_runs_ : sampled_runs_;
+        if (!runs.empty() && runs.back().to == j) {
+          ++runs.back().to;
+        } else {
+          runs.push_back({j, j + 1});
+        }
+        if (!fixed[j]) continue;
+        fixed_rot_[j] = fixed_rot[j] = glm::normalize(first.frame_rotations(0)[j]);
+        fixed_trans_[j] = fixed_trans[j] = first.frame_translations(0)[j];
+      }
+    }
+  }
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   coarse_ = make_coarse_rig(library);
   const size_t K = static_cast<size_t>(coarse_.num_coarse);
-  scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>([J, K, fixed_trans] {
-    Scratch s;
-    s.rot.resize(2 * kMaxBlendLayers * J);
-    s.trans.resize(2 * kMaxBlendLayers * J);
-    s.local_trans = fixed_trans;  // the fixed ones stay; the others are sampled per agent
-    s.coarse_rot.resize(K);
-    s.coarse_trans.resize(K);
-    s.world.resize(J);
-    s.local_rot.resize(J);
-    return s;
-  });
+  scratch_ = std::make_unique<tbb::enumerable_thread_specific<Scratch>>(
+      [J, K, fixed_trans, fixed_rot] {
+        Scratch s;
+        s.rot.resize(2 * kMaxBlendLayers * J);
+        s.trans.resize(2 * kMaxBlendLayers * J);
+        s.local_trans = fixed_trans;  // the fixed ones stay; the others are sampled per agent
+        s.coarse_rot.resize(K);
+        s.coarse_trans.resize(K);
+        s.world.resize(J);
+        s.local_rot = fixed_rot;
+        return s;
+      });
   subtree_end_ = subtree_ends(skeleton_);
   for (Side side : {Side::kLeft, Side::kRight}) {
     const int hip = skeleton_.hip(side), knee = skeleton_.knee(side);
@@ -364,8 +423,10 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
   // The coarse clips have joints of their own: all sampled.
   const std::span<const int16_t> translated =
       coarse ? std::span<const int16_t>() : std::span<const int16_t>(translated_joints_);
+  const std::span<const JointRun> runs =
+      coarse ? std::span<const JointRun>() : std::span<const JointRun>(sampled_runs_);
   if (num_weighted == 1) {
-    SampleClipJob{clip_of[a], time_of[a], out_rot, out_trans, translated}.run();
+    SampleClipJob{clip_of[a], time_of[a], out_rot, out_trans, translated, runs}.run();
     return;
   }
   if (num_weighted == 2) {
@@ -379,6 +440,7 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
     job.out_rotations = out_rot;
     job.out_translations = out_trans;
     job.translated_joints = translated;
+    job.sampled_runs = runs;
     job.run();
     return;
   }
@@ -390,6 +452,12 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
     layers[i] = {r, t, weight_of[i]};
   }
   BlendPosesJob{{layers, static_cast<size_t>(num_samples)}, out_rot, out_trans, translated}.run();
+  if (coarse) return;
+  for (const JointRun& r : fixed_runs_) {  // blended from every joint's samples: kept as they were
+    std::copy(fixed_rot_.begin() + r.from, fixed_rot_.begin() + r.to, out_rot.begin() + r.from);
+    std::copy(fixed_trans_.begin() + r.from, fixed_trans_.begin() + r.to,
+              out_trans.begin() + r.from);
+  }
 }
 
 void PoseSynthesizer::fk(glm::mat4* world, const glm::quat* rot, const glm::vec3* trans, int from,

@@ -13,6 +13,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 
+#include "animation/pose_jobs.h"
 #include "mediator/animation_plans.h"
 #include "mediator/coarse_pose.h"
 #include "mediator/foot_lock.h"
@@ -179,6 +180,12 @@ class PoseSynthesizer {
   // The joints whose translations are sampled per agent (ascending), or empty: all of them. The
   // others' are the same in every frame of every clip and kept in each Scratch's local_trans.
   std::vector<int16_t> translated_joints_;
+  // Joints no clip moves (whole subtrees the pose stage reads nothing of: the mannequin's
+  // fingers) are not sampled per agent: their pose (fixed_rot_, fixed_trans_) stays in each
+  // Scratch. sampled_runs_ are the other joints, or empty: all of them.
+  std::vector<JointRun> sampled_runs_, fixed_runs_;
+  std::vector<glm::quat> fixed_rot_;
+  std::vector<glm::vec3> fixed_trans_;
   bool affine_inverse_bind_ = false;
   bool translation_inverse_bind_ = false;  // is_translation(inverse_bind_): the cheaper palette
   bool stream_palettes_ = false;

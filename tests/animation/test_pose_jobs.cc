@@ -334,6 +334,59 @@ TEST(PoseJobs, TranslatedJointsOnlyAreWrittenAsWithoutTheList) {
   EXPECT_FALSE((SampleClipJob{&a, 0.0f, r, t, outside}.validate()));
 }
 
+// With runs of sampled joints, the jobs write those joints' rotations and translations as they
+// would without them (the same bits: runs of one to three joints through the padded path, longer
+// ones with their last four again; the root's step across a wrap too) and leave the others alone.
+TEST(PoseJobs, SampledRunsOnlyAreWrittenAsWithoutThem) {
+  std::mt19937 rng(35);
+  const int n = 25;
+  const Clip a = random_clip(n, 7, rng), b = random_clip(n, 9, rng);
+  const std::vector<JointRun> run_sets[] = {
+      {{0, 11}, {13, 14}, {18, 25}}, {{0, 3}, {5, 9}}, {{2, 25}}, {{0, 25}}};
+  const glm::quat kept_r(0.5f, 0.5f, -0.5f, 0.5f);
+  const glm::vec3 kept_t(7.0f, -7.0f, 7.0f);
+  for (const std::vector<JointRun>& runs : run_sets) {
+    auto in_runs = [&](int j) {
+      for (const JointRun& r : runs) {
+        if (j >= r.from && j < r.to) return true;
+      }
+      return false;
+    };
+    for (const float time : {0.05f, (a.num_frames - 0.4f) / a.fps}) {
+      std::vector<glm::quat> r_all(n), r_some(n, kept_r), br_all(n), br_some(n, kept_r);
+      std::vector<glm::vec3> t_all(n), t_some(n, kept_t), bt_all(n), bt_some(n, kept_t);
+      SampleClipJob{&a, time, r_all, t_all}.run();
+      SampleClipJob some{&a, time, r_some, t_some, {}, runs};
+      ASSERT_TRUE(some.validate());
+      some.run();
+      SampleBlendJob blend;
+      blend.a = {&a, time, 0.7f};
+      blend.b = {&b, 0.5f * time + 0.1f, 1.3f};
+      blend.out_rotations = br_all;
+      blend.out_translations = bt_all;
+      blend.run();
+      blend.out_rotations = br_some;
+      blend.out_translations = bt_some;
+      blend.sampled_runs = runs;
+      ASSERT_TRUE(blend.validate());
+      blend.run();
+      for (int j = 0; j < n; ++j) {
+        const bool sampled = in_runs(j);
+        EXPECT_EQ(r_some[j], sampled ? r_all[j] : kept_r) << "joint " << j;
+        EXPECT_EQ(t_some[j], sampled ? t_all[j] : kept_t) << "joint " << j;
+        EXPECT_EQ(br_some[j], sampled ? br_all[j] : kept_r) << "joint " << j;
+        EXPECT_EQ(bt_some[j], sampled ? bt_all[j] : kept_t) << "joint " << j;
+      }
+    }
+  }
+  std::vector<glm::quat> r(n);
+  std::vector<glm::vec3> t(n);
+  const std::vector<JointRun> overlapping = {{0, 5}, {4, 8}}, outside = {{20, 26}}, empty = {{3, 3}};
+  EXPECT_FALSE((SampleClipJob{&a, 0.0f, r, t, {}, overlapping}.validate()));
+  EXPECT_FALSE((SampleClipJob{&a, 0.0f, r, t, {}, outside}.validate()));
+  EXPECT_FALSE((SampleClipJob{&a, 0.0f, r, t, {}, empty}.validate()));
+}
+
 TEST(SampleBlendJob, ValidateRefusesUnweightedOrMismatchedInputs) {
   std::mt19937 rng(5);
   const Clip a = random_clip(4, 3, rng), b = random_clip(4, 3, rng), c = random_clip(5, 3, rng);
