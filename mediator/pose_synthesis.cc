@@ -211,6 +211,13 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
       }
     }
   }
+  // The fixed joints' rotations are set in local_rot_ once (finish_pose writes the others).
+  for (size_t slot = 0; slot < capacity; ++slot) {
+    for (const JointRun& r : fixed_runs_) {
+      std::copy(fixed_rot_.begin() + r.from, fixed_rot_.begin() + r.to,
+                local_rot_.begin() + slot * J + r.from);
+    }
+  }
   // Per-thread sampling scratch, made once per worker thread on first use and kept.
   coarse_ = make_coarse_rig(library);
   const size_t K = static_cast<size_t>(coarse_.num_coarse);
@@ -583,10 +590,24 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
     // the smallest |dot| (acos falls): one acos per agent. Joint 0 carries the root facing, not a
     // local bend. The new rotations replace the old as they are read.
     local_rot_[base] = rot[0];
-    change = 2.0f * std::acos(min_abs_dot_then_copy({rot + 1, J - 1},
-                                                    {local_rot_.data() + base + 1, J - 1}));
-  } else if (rot) {
+    float d = 1.0f;
+    if (fixed_runs_.empty()) {
+      d = min_abs_dot_then_copy({rot + 1, J - 1}, {local_rot_.data() + base + 1, J - 1});
+    } else {  // the fixed joints' rotations stay as they are in local_rot_ (set once)
+      for (const JointRun& r : sampled_runs_) {
+        const size_t from = static_cast<size_t>(std::max(r.from, 1)), to = r.to;
+        if (from >= to) continue;
+        d = std::min(d, min_abs_dot_then_copy({rot + from, to - from},
+                                              {local_rot_.data() + base + from, to - from}));
+      }
+    }
+    change = 2.0f * std::acos(d);
+  } else if (rot && fixed_runs_.empty()) {
     std::copy_n(rot, J, local_rot_.begin() + base);
+  } else if (rot) {
+    for (const JointRun& r : sampled_runs_) {
+      std::copy(rot + r.from, rot + r.to, local_rot_.begin() + base + r.from);
+    }
   }
   rot_change_[slot] = change;
   // The toes as drawn, in every mode: foot locking starts from them (also after being off).
