@@ -1092,19 +1092,44 @@ inline Quat4 quat_cast4(const glm::mat4& m0, const glm::mat4& m1, const glm::mat
 }  // namespace
 #endif
 
+TwoBoneIKJob TwoBoneIKLimb::job() const {
+  TwoBoneIKJob j;
+  j.start_model = *start_model;
+  j.mid_model = *mid_model;
+  j.end_model = *end_model;
+  j.target = target;
+  j.pole = pole;
+  j.max_extension = max_extension;
+  j.soften = soften;
+  j.out_start_correction = out_start_correction;
+  j.out_mid_correction = out_mid_correction;
+  return j;
+}
+
 void two_bone_ik_pair(const TwoBoneIKJob& ja, const TwoBoneIKJob& jb) {
+  if (ja.out_reached || jb.out_reached || !(ja.weight == 1.0f) || !(jb.weight == 1.0f)) {
+    ja.run();
+    jb.run();
+    return;
+  }
+  auto limb = [](const TwoBoneIKJob& j) {
+    return TwoBoneIKLimb{&j.start_model,  &j.mid_model, &j.end_model,
+                         j.target,        j.pole,       j.max_extension,
+                         j.soften,        j.out_start_correction, j.out_mid_correction};
+  };
+  two_bone_ik_pair(limb(ja), limb(jb));
+}
+
+void two_bone_ik_pair(const TwoBoneIKLimb& ja, const TwoBoneIKLimb& jb) {
 #if defined(__SSE2__)
   using namespace pair_ik;
   auto one_by_one = [&] {
-    ja.run();
-    jb.run();
+    ja.job().run();
+    jb.job().run();
   };
-  if (ja.out_reached || jb.out_reached || !(ja.weight == 1.0f) || !(jb.weight == 1.0f)) {
-    return one_by_one();
-  }
-  const V3 a = pair(translation_of(ja.start_model), translation_of(jb.start_model));
-  const V3 b = pair(translation_of(ja.mid_model), translation_of(jb.mid_model));
-  const V3 c = pair(translation_of(ja.end_model), translation_of(jb.end_model));
+  const V3 a = pair(translation_of(*ja.start_model), translation_of(*jb.start_model));
+  const V3 b = pair(translation_of(*ja.mid_model), translation_of(*jb.mid_model));
+  const V3 c = pair(translation_of(*ja.end_model), translation_of(*jb.end_model));
   const V3 target = pair(ja.target, jb.target);
   const V3 pole = pair(ja.pole, jb.pole);
   const V3 ba = sub(b, a), cb = sub(c, b);
@@ -1179,7 +1204,7 @@ void two_bone_ik_pair(const TwoBoneIKJob& ja, const TwoBoneIKJob& jb) {
     r = select(twist, mul(t, r), r);
   }
   // Lanes (a start, b start, a mid, b mid): conjugate_into of r and r_knee.
-  const Quat4 q = quat_cast4(ja.start_model, jb.start_model, ja.mid_model, jb.mid_model);
+  const Quat4 q = quat_cast4(*ja.start_model, *jb.start_model, *ja.mid_model, *jb.mid_model);
   const __m128 mid_lanes = _mm_castsi128_ps(_mm_setr_epi32(0, 0, -1, -1));
   const Quat4 rr = select(mid_lanes, r_knee, r);
   glm::quat out[4];
@@ -1189,8 +1214,8 @@ void two_bone_ik_pair(const TwoBoneIKJob& ja, const TwoBoneIKJob& jb) {
   *ja.out_mid_correction = out[2];
   *jb.out_mid_correction = out[3];
 #else
-  ja.run();
-  jb.run();
+  ja.job().run();
+  jb.job().run();
 #endif
 }
 

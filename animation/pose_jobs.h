@@ -151,6 +151,21 @@ struct TwoBoneIKJob {
 // an out_reached asked for) run the jobs one by one. Without SSE2: a.run(); b.run().
 void two_bone_ik_pair(const TwoBoneIKJob& a, const TwoBoneIKJob& b);
 
+// A TwoBoneIKJob of weight 1 without out_reached, its matrices by pointer: two_bone_ik_pair's
+// inputs without copying three matrices per limb (no member initialisers: nothing is written
+// before the caller's fields).
+struct TwoBoneIKLimb {
+  const glm::mat4* start_model;
+  const glm::mat4* mid_model;
+  const glm::mat4* end_model;
+  glm::vec3 target, pole;
+  float max_extension, soften;
+  glm::quat* out_start_correction;
+  glm::quat* out_mid_correction;
+  TwoBoneIKJob job() const;  // the same limb as a job
+};
+void two_bone_ik_pair(const TwoBoneIKLimb& a, const TwoBoneIKLimb& b);
+
 // Skinning matrices: out[j] = model[j] * inverse_bind[j]. Affine inverse binds (bottom row
 // 0 0 0 1, as every rig's) take the cheaper affine product; affine_inverse_bind tells which
 // (is_affine(inverse_bind) once per rig; false always gives the full product).

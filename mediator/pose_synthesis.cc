@@ -820,7 +820,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     if (use_ik[side]) ankle_world_rot[side] = rotation_of(world[ankle]);
   }
   if (!use_ik[0] && !use_ik[1]) return;
-  TwoBoneIKJob ik[2];
+  TwoBoneIKLimb ik[2];
   glm::quat c_hip[2], c_knee[2];
   for (int side = 0; side < 2; ++side) {
     if (!use_ik[side]) continue;
@@ -896,10 +896,10 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     glm::vec3 pole = (knee_p - hip_p) - axis * glm::dot(knee_p - hip_p, axis);
     if (glm::length(pole) < 1e-4f) pole = glm::vec3(root[2]);
     // Both legs' IK in one pass (the legs' world joints stay as posed until fk_list below).
-    TwoBoneIKJob& job = ik[side];
-    job.start_model = world[hip];
-    job.mid_model = world[knee];
-    job.end_model = world[ankle];
+    TwoBoneIKLimb& job = ik[side];
+    job.start_model = &world[hip];
+    job.mid_model = &world[knee];
+    job.end_model = &world[ankle];
     job.target = goal_ankle;
     job.pole = pole;
     job.soften = kIkSoften;
@@ -910,7 +910,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   if (use_ik[0] && use_ik[1]) {
     two_bone_ik_pair(ik[0], ik[1]);
   } else {
-    ik[use_ik[0] ? 0 : 1].run();
+    ik[use_ik[0] ? 0 : 1].job().run();
   }
   for (int side = 0; side < 2; ++side) {
     if (!use_ik[side]) continue;
