@@ -20,7 +20,9 @@
 //   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing);
 //                             it sets off from rest (its rest carried on and shed)
 //   kLocked    -> kStepping   start_foot_step: left too far behind while the other foot is pinned
-//                             and the clips are not walking (their own swing re-places it)
+//                             and the clips are not walking (their own swing re-places it); or
+//                             (pose synthesis) a leg that cannot reach its pin, walking or not,
+//                             while the clips keep weight on the foot and the other is pinned
 //   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done (the
 //                             step's velocity is carried on and shed: no jump to the clip's)
 //   kStepping  -> kLocked     the step has landed: pinned at the clip's toe

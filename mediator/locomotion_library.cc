@@ -570,14 +570,20 @@ std::vector<float> transition_phase_track(const LocomotionClip& lc, const Locomo
   };
   std::vector<Landing> landings;
   for (int s = 0; s < 2; ++s) {
+    float last = -1e9f;
     for (const TimeInterval& c : lc.analysis.contacts[s]) {
-      if (c.start_s >= 0.5f * frame_s && landing_phase(cycle, s) >= 0.0f) {
+      // A foot that lands again within half a cycle of its last landing scuffed: not a step.
+      if (c.start_s >= 0.5f * frame_s && landing_phase(cycle, s) >= 0.0f &&
+          c.start_s - last >= 0.5f * cycle.cycle_s) {
         landings.push_back({c.start_s, s});
       }
+      last = c.start_s;
     }
   }
-  std::sort(landings.begin(), landings.end(),
-            [](const Landing& a, const Landing& b) { return a.t < b.t; });
+  // In time; on one frame the left first.
+  std::sort(landings.begin(), landings.end(), [](const Landing& a, const Landing& b) {
+    return a.t < b.t || (a.t == b.t && a.side < b.side);
+  });
   // Unwrapped: each landing is the cycle's landing of that foot, the next one on from the last
   // (half a cycle for the other foot; the same foot twice in a row, a whole cycle).
   std::vector<float> at(landings.size());
@@ -629,13 +635,21 @@ float Transition::phase_at(float t_s) const {
   const size_t n = phase_track.size();
   if (n == 0) return 0.0f;
   if (n == 1) return phase_track[0] - std::floor(phase_track[0]);
-  // Between frames linearly; beyond the ends on along the end's own slope (the cycle's rate), so
-  // a start handing over at its last frame leaves the phase moving as the cycle goes on.
+  // Between frames linearly (beyond the ends along the end's slope, the cycle's rate; the clock
+  // that reads it stops at the clip's end).
   const float x = t_s * fps;
   const size_t i = x <= 0.0f ? 0 : std::min(static_cast<size_t>(x), n - 2);
   const float p =
       phase_track[i] + (x - static_cast<float>(i)) * (phase_track[i + 1] - phase_track[i]);
   return p - std::floor(p);
+}
+
+float Transition::phase_rate_at(float t_s) const {
+  const size_t n = phase_track.size();
+  if (n < 2) return 1.0f;
+  const float x = t_s * fps;
+  const size_t i = x <= 0.0f ? 0 : std::min(static_cast<size_t>(x), n - 2);
+  return std::max((phase_track[i + 1] - phase_track[i]) * fps, 1e-3f);
 }
 
 float LocomotionClip::time_at_phase(float phase) const {

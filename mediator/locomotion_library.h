@@ -92,7 +92,7 @@ struct Transition {
   float moving_speed_m_s = 0.0f;  // over its moving end: a start's last or a stop's first 0.25 s
   // The steady cycle (forward, nearest in speed) a start hands over to or a stop takes over from,
   // and that cycle's gait phase at the transition's moving end (matched on the foot contacts:
-  // the same foot landed as long ago).
+  // the same foot landed as long ago; phase_track has the phase at every clip time).
   int cycle_clip = -1;
   float cycle_phase = 0.0f;
   // Side of the foot that leads: a start's first foot to leave the ground, a stop's last to land.
@@ -109,6 +109,7 @@ struct Transition {
   std::vector<float> phase_track;
   float speed_at(float t_s) const;  // speed_m_s between frames, held beyond the ends
   float phase_at(float t_s) const;  // phase_track between frames, in [0, 1)
+  float phase_rate_at(float t_s) const;  // its slope there [cycles per clip second], > 0
 };
 
 // What the library made of a take with root motion: its segments and the clips cut from it.

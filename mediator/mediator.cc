@@ -329,6 +329,8 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
     const float end = library_.transitions[tr_index_[slot]].duration_s;
     tr_time_[slot] = std::min(before + tr_rate_[slot] * dt, end);
     lod_tr_advance_[slot] += tr_time_[slot] - before;
+    // The gait phase follows the transition's own steps, as the transition pass has it.
+    pl.phase[slot] = library_.transitions[tr_index_[slot]].phase_at(tr_time_[slot]);
   }
   // Only the layers pose synthesis samples (weight > 0); the contacts pass sets them all again
   // at the next plan.

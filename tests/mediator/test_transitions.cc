@@ -239,7 +239,6 @@ TEST(Transitions, AChosenStopIsKeptThroughASpeedBumpBelowTheSpeedItWasChosenAt) 
   const float chosen_at = v;
   for (int f = 0; f < 3; ++f) step(v -= 1.0f * kDt);
   step(v += 0.6f * kDt);  // a frame's rise, still below the speed the stop was chosen at
-  EXPECT_LT(v, chosen_at);
   EXPECT_EQ(stage[0], TransitionStage::kWaiting) << "given up for a frame's rise of the speed";
   step(v = chosen_at + 0.05f);  // walking on, faster than it was
   EXPECT_EQ(stage[0], TransitionStage::kNone) << "kept though the agent walks on";
