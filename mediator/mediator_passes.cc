@@ -542,7 +542,7 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
         st.min_cadence[slot] = 0.0f;
         float late = phase[slot] - entry_phase;
         if (late < 0.0f) late += 1.0f;
-        t += late / tr.phase_rate_at(t);
+        t = std::min(t + late / tr.phase_rate_at(t), tr.duration_s);
         st.lag_m[slot] = 0.0f;
         w = 0.0f;
       }
