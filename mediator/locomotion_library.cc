@@ -1415,6 +1415,15 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   for (LocomotionClip& c : lib.clips) {
     if (c.gait) set_lift_phases(&c);
   }
+  {
+    constexpr float kGravity = 9.81f;          // [m/s^2]
+    constexpr float kTransitionFroude = 0.5f;  // walk-run transition (Alexander; GAIT.md's 2 m/s)
+    const float hip_height = 0.5f * (lib.leg_length_m[0] + lib.leg_length_m[1] +
+                                     lib.planted_ankle_m[0] + lib.planted_ankle_m[1]);
+    if (hip_height > 0.0f) {
+      lib.walk_run_speed_m_s = std::sqrt(kTransitionFroude * kGravity * hip_height);
+    }
+  }
   return lib;
 }
 

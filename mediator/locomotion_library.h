@@ -134,6 +134,10 @@ struct LocomotionLibrary {
   int forward_group = -1;
   float max_speed_m_s = 0.0f;
   float leg_length_m[2] = {0.0f, 0.0f};  // hip-knee + knee-ankle in the rest pose
+  // Where people switch from walking to running (GAIT.md: about 2 m/s): Froude number
+  // v^2 / (g h) = 0.5 for this skeleton's hip height h over a planted ankle [m/s]. Below it the
+  // blend of a walk and a run keeps the walk the heavier (its feet and contacts): mediator_passes.
+  float walk_run_speed_m_s = 2.0f;
   // Height of each toe joint when the foot is flat on the ground [m] (lowest over the gait clips):
   // planted feet are locked at this height.
   float toe_floor_m[2] = {0.0f, 0.0f};

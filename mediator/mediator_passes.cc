@@ -56,7 +56,17 @@ void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, fl
   for (size_t k = 0; k + 1 < c.size(); ++k) {
     const float a = lib.clips[c[k]].speed_m_s, b = lib.clips[c[k + 1]].speed_m_s;
     if (speed <= b) {
-      const float u = (speed - a) / std::max(b - a, 1e-6f);
+      // Between a walk and a run the heavier clip's feet lead (its contacts win the vote, its
+      // swing dominates): the run, with its flight phase, never outweighs the walk below the
+      // walk-run transition speed. Where the clips' midpoint is below it, the run's weight
+      // reaches one half there, not at the midpoint (a slow walk and a bouncy jog would
+      // otherwise have a 1.9 m/s pedestrian float between strides).
+      float even = 0.5f * (a + b);  // speed at which the two weigh the same
+      if (lib.clips[c[k]].double_support && !lib.clips[c[k + 1]].double_support) {
+        even = std::clamp(lib.walk_run_speed_m_s, even, b);
+      }
+      const float u = speed <= even ? 0.5f * (speed - a) / std::max(even - a, 1e-6f)
+                                    : 0.5f + 0.5f * (speed - even) / std::max(b - even, 1e-6f);
       w[c[k]] += share * (1.0f - u);
       w[c[k + 1]] += share * u;
       return;
