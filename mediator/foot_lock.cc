@@ -59,7 +59,8 @@ void pin_height(FootLock& s, const FootLockInput& in) {
 // The offset of a foot that is not being released decays toward zero (Holden's decay spring:
 // exact for any dt).
 void decay_offset(FootLock& s, const FootLockParams& p, float dt) {
-  critical_spring(s.offset, s.offset_vel, glm::vec3(0.0f), p.release_halflife_s, dt);
+  const float halflife = s.offset_halflife_s > 0.0f ? s.offset_halflife_s : p.release_halflife_s;
+  critical_spring(s.offset, s.offset_vel, glm::vec3(0.0f), halflife, dt);
 }
 
 void plant(FootLock& s, const FootLockInput& in) {
@@ -78,6 +79,22 @@ void plant(FootLock& s, const FootLockInput& in) {
   if (!in.fresh) above = std::min(above, std::max(0.0f, in.drawn_toe_prev.y - in.anim_toe_prev.y));
   s.offset = glm::vec3(0.0f, above, 0.0f);
   s.offset_vel = glm::vec3(0.0f);
+  s.offset_halflife_s = 0.0f;
+}
+
+// A foot pinned while it still moves over the ground at `moving` [m/s] glides to its pin: the pin
+// is set where a critically damped spring of the glide's halflife, starting at that speed, comes
+// to rest (moving / y ahead, y its damping over two), so the drawn foot's velocity is continuous
+// and falls off exponentially, with no overshoot. Stopped in a frame instead, a foot landing at
+// a run's swing speed snaps the ankle and knee (hundreds of m/s^2).
+void glide_to_pin(FootLock& s, const glm::vec3& moving, const FootLockParams& p) {
+  const float halflife = std::max(p.glide_halflife_s, 1e-3f);
+  const float y = 0.5f * halflife_to_damping(halflife);
+  const glm::vec3 ahead = moving / y;
+  s.target += ahead;
+  s.offset -= ahead;
+  s.offset_vel = moving;
+  s.offset_halflife_s = halflife;
 }
 
 // The vectors by value: callers pass fields of s itself.
@@ -124,7 +141,12 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
       const bool at_rest = in.fresh || speed <= in.still_speed_m_s || clip_at_rest ||
                            (last_speed >= 0.0f && speed >= last_speed);
       const bool carries_weight = !in.other_locked;
-      if (in.plant && (at_rest || carries_weight)) plant(s, in);
+      if (in.plant && (at_rest || carries_weight)) {
+        // The drawn foot's velocity over the ground last frame (the goal's).
+        const glm::vec3 moving(s.goal_vel.x, 0.0f, s.goal_vel.z);
+        plant(s, in);
+        if (!at_rest && usable(moving)) glide_to_pin(s, moving, p);
+      }
       return;
     }
     case FootLockState::kLocked: {

@@ -10,8 +10,9 @@
 // correction happens in the air, and the swing keeps the clip's own height. A foot that lands
 // settles onto the floor through a decaying offset (a critically damped spring, exact for any
 // step). A pinned toe follows the clip's down as the foot rolls onto its ball, and up only while
-// the other foot is pinned (pushing off onto the toes). A pinned foot left far behind by a turn or a drift re-plants (start_foot_step), while the
-// other foot is pinned, with a short step as high as the clips' own swing.
+// the other foot is pinned (pushing off onto the toes). A pinned foot left far behind by a turn or
+// a drift re-plants (start_foot_step), while the other foot is pinned, with a short step as high as
+// the clips' own swing.
 //
 //   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest (or
 //                             rests in the clips, moving no faster than twice the still speed),
@@ -41,22 +42,23 @@ enum class FootLockState : uint8_t { kFree, kLocked, kReleasing, kStepping };
 // One foot's lock (explicit state; the caller stores it).
 struct FootLock {
   FootLockState state = FootLockState::kFree;
-  glm::vec3 target{0.0f};      // pinned toe (world) [m]; y is the floor
-  glm::vec3 offset{0.0f};      // inertialization offset added to the goal [m]
-  glm::vec3 offset_vel{0.0f};  // its rate [m/s]
-  glm::vec3 from{0.0f};        // stepping: where the step started [m]
-  float timer_s = 0.0f;        // stepping: time since the step started [s]
-  glm::vec3 step_to{0.0f};     // stepping: where it is set down (chosen as it starts to lower) [m]
-  glm::vec3 last_goal{0.0f};   // the goal returned last frame [m]
-  glm::vec3 goal_vel{0.0f};    // its velocity [m/s] (a step turned release keeps its speed)
-  float shed = 0.0f;           // releasing: share of the release offset shed so far, 0..1
-  float swing_from = 0.0f;     // releasing: the swing progress at release
-  float last_progress = 0.0f;  // releasing: the swing progress last frame
-  float shed_from = 0.0f;      // releasing: share shed when that progress was taken
-  float shed_goal = 0.0f;      // releasing: share the swing's progress asks for
-  float released_s = 0.0f;     // releasing: time since the release [s]
-  float release_time_s = 0.0f; // releasing: the shortest time to shed the offset in [s]
-  float anim_speed = -1.0f;    // the clip's toe speed over the ground last frame [m/s] (< 0: none)
+  glm::vec3 target{0.0f};          // pinned toe (world) [m]; y is the floor
+  glm::vec3 offset{0.0f};          // inertialization offset added to the goal [m]
+  glm::vec3 offset_vel{0.0f};      // its rate [m/s]
+  float offset_halflife_s = 0.0f;  // pinned: halflife the offset decays with (0: the landing's)
+  glm::vec3 from{0.0f};            // stepping: where the step started [m]
+  float timer_s = 0.0f;            // stepping: time since the step started [s]
+  glm::vec3 step_to{0.0f};      // stepping: where it is set down (chosen as it starts to lower) [m]
+  glm::vec3 last_goal{0.0f};    // the goal returned last frame [m]
+  glm::vec3 goal_vel{0.0f};     // its velocity [m/s] (a step turned release keeps its speed)
+  float shed = 0.0f;            // releasing: share of the release offset shed so far, 0..1
+  float swing_from = 0.0f;      // releasing: the swing progress at release
+  float last_progress = 0.0f;   // releasing: the swing progress last frame
+  float shed_from = 0.0f;       // releasing: share shed when that progress was taken
+  float shed_goal = 0.0f;       // releasing: share the swing's progress asks for
+  float released_s = 0.0f;      // releasing: time since the release [s]
+  float release_time_s = 0.0f;  // releasing: the shortest time to shed the offset in [s]
+  float anim_speed = -1.0f;     // the clip's toe speed over the ground last frame [m/s] (< 0: none)
   // Releasing: the foot's own velocity over the ground (a pinned foot's rest, or a step's speed)
   // against the clip's, carried on and shed by a critically damped spring (inertialization), so
   // the drawn foot's velocity does not jump to the clip's [m], and its rate [m/s].
@@ -109,6 +111,10 @@ struct FootLockParams {
   // [s] halflife of a released foot's carried velocity (its rest, or a step's speed, against the
   // clip's): the lock's whole release time, so the foot picks up the clip's swing over it.
   float carry_halflife_s = 0.12f;
+  // [s] halflife of the glide of a foot pinned while it still moves over the ground (it takes the
+  // weight as the other foot leaves it): its speed then falls from what it was, not to zero in a
+  // frame. Half the landing offset's: loaded, it stops faster than a settling foot.
+  float glide_halflife_s = 0.03f;
 };
 
 // One frame of one foot: its next state and where its toe should be drawn (world, before any

@@ -707,7 +707,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                                 glm::mat4* world, glm::quat* rot, const glm::vec3* trans,
                                 const glm::mat4& root, float dt, bool letting_go) {
   const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
-                          library_.swing_height_m, library_.swing_speed_m_s, P.lock_release_s};
+                          library_.swing_height_m, library_.swing_speed_m_s, P.lock_release_s,
+                          0.25f * P.lock_release_s};
   glm::vec3 goal[2], anim_toe[2], anim_vel[2];
   bool pinned[2] = {false, false};
   for (int side = 0; side < 2; ++side) {

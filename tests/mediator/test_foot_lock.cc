@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -119,6 +120,45 @@ TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
     if (locked_at < 0 && fast.lock.state == FootLockState::kLocked) locked_at = i;
   }
   EXPECT_EQ(locked_at, 3);
+}
+
+// A foot that must take the weight while it still moves fast (the other foot has left the ground:
+// a run's landing, or a blend between a run and a walk) is pinned at once, but its speed falls
+// off from what it was over a few frames, as a critically damped spring of glide_halflife_s
+// stops it, not to zero in one frame (which snaps the ankle and knee).
+TEST(FootLock, AFootThatMustTakeTheWeightWhileMovingGlidesToItsPin) {
+  Foot foot;
+  const float still = 0.5f;  // [m/s]
+  float x = 0.0f;
+  foot.step({x, 0.03f, 0.0f}, false, false, 0.9f, false, still);
+  // Swinging in at 4 m/s, still slowing (so not at rest), the other foot off the ground.
+  float v = 4.0f;
+  for (int f = 0; f < 4; ++f) {
+    x += v * kDt;
+    foot.step({x, kFloor, 0.0f}, false, false, 0.95f, false, still);
+  }
+  const float drawn_speed = v;
+  const float pinned_from = foot.goal.x;
+  float prev_x = foot.goal.x, prev_speed = drawn_speed, max_drop = 0.0f;
+  for (int f = 0; f < 30; ++f) {
+    v = std::max(0.0f, v - 0.3f);
+    x += v * kDt;
+    foot.step({x, kFloor, 0.0f}, true, true, 0.0f, false, still);
+    ASSERT_EQ(foot.lock.state, FootLockState::kLocked) << f;
+    const float speed = (foot.goal.x - prev_x) / kDt;
+    EXPECT_GE(speed, -1e-3f) << "the glide overshot its pin and came back, frame " << f;
+    EXPECT_LE(speed, prev_speed + 1e-3f) << "the glide sped up, frame " << f;
+    max_drop = std::max(max_drop, prev_speed - speed);
+    prev_x = foot.goal.x;
+    prev_speed = speed;
+  }
+  // Exponential at the glide's damping y = 2 ln 2 / halflife: the first frame keeps
+  // exp(-y dt) of the speed (46%), so no frame loses more than 54% of 4 m/s (all of it before).
+  const float y = 2.0f * std::numbers::ln2_v<float> / foot.params.glide_halflife_s;
+  EXPECT_LE(max_drop, drawn_speed * (1.0f - std::exp(-y * kDt)) + 0.01f);
+  EXPECT_LT(prev_speed, 0.01f);  // at rest after half a second
+  // It comes to rest v / y beyond where it was drawn when pinned (8.7 cm): a short glide.
+  EXPECT_NEAR(foot.goal.x - pinned_from, drawn_speed / y, 0.005f);
 }
 
 // A ball at rest in the clips has landed, though the blend's changing weights (a walk fading in
