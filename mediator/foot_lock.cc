@@ -142,10 +142,14 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
                            (last_speed >= 0.0f && speed >= last_speed);
       const bool carries_weight = !in.other_locked;
       if (in.plant && (at_rest || carries_weight)) {
-        // The drawn foot's velocity over the ground last frame (the goal's).
+        // The drawn foot's velocity over the ground last frame (the goal's). It glides to its pin
+        // when pinned before it is at rest, and when it is still carried over the ground faster
+        // than the clip's ball by more than the body's own speed (twice the still speed): a
+        // released foot still shedding its offset, whose ball in the clips has landed.
         const glm::vec3 moving(s.goal_vel.x, 0.0f, s.goal_vel.z);
+        const bool carried = ground_length(moving.x, moving.z) > speed + 2.0f * in.still_speed_m_s;
         plant(s, in);
-        if (!at_rest && usable(moving)) glide_to_pin(s, moving, p);
+        if ((!at_rest || carried) && !in.fresh && usable(moving)) glide_to_pin(s, moving, p);
       }
       return;
     }

@@ -104,7 +104,8 @@ TEST(FootLock, PlantWaitsForTheBallToComeToRest) {
   ASSERT_EQ(foot.lock.state, FootLockState::kLocked);
   EXPECT_FLOAT_EQ(foot.goal.x, drawn_before);
   // Pinned: the clip's toe creeps on, the drawn one stays.
-  for (int f = 0; f < 10; ++f) foot.step({x += 0.001f, kFloor, 0.0f}, true, true, 0.0f, true, still);
+  for (int f = 0; f < 10; ++f)
+    foot.step({x += 0.001f, kFloor, 0.0f}, true, true, 0.0f, true, still);
   EXPECT_FLOAT_EQ(foot.goal.x, drawn_before);
 
   // A ball that never gets slower than the still speed (the crowd walks faster than the clip) is
@@ -159,6 +160,21 @@ TEST(FootLock, AFootThatMustTakeTheWeightWhileMovingGlidesToItsPin) {
   EXPECT_LT(prev_speed, 0.01f);  // at rest after half a second
   // It comes to rest v / y beyond where it was drawn when pinned (8.7 cm): a short glide.
   EXPECT_NEAR(foot.goal.x - pinned_from, drawn_speed / y, 0.005f);
+
+  // The clip's ball has landed (at rest) but the drawn foot is still carried at 3 m/s, faster
+  // than it by more than the body's speed (twice the still speed): it glides as well.
+  Foot carried;
+  x = 0.0f;
+  carried.step({x, 0.03f, 0.0f}, false, false, 0.9f, true, still);
+  for (int f = 0; f < 4; ++f)
+    carried.step({x += 3.0f * kDt, kFloor, 0.0f}, false, false, 0.95f, true, still);
+  const float carried_from = carried.goal.x;
+  carried.step({x, kFloor, 0.0f}, true, true, 0.0f, true, still);
+  ASSERT_EQ(carried.lock.state, FootLockState::kLocked);
+  // Its first frame covers the glide's share 1 - exp(-y dt) of 3 / y: 2.1 m/s, not 0.
+  EXPECT_NEAR(carried.goal.x - carried_from, 3.0f / y * (1.0f - std::exp(-y * kDt)), 1e-3f);
+  for (int f = 0; f < 30; ++f) carried.step({x, kFloor, 0.0f}, true, true, 0.0f, true, still);
+  EXPECT_NEAR(carried.goal.x - carried_from, 3.0f / y, 0.005f);
 }
 
 // A ball at rest in the clips has landed, though the blend's changing weights (a walk fading in
