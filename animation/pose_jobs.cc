@@ -14,6 +14,7 @@
 #include <glm/gtx/quaternion.hpp>
 
 #include "animation/fk_compose.h"
+#include "animation/near_fmod.h"
 #include "animation/quat_sse.h"
 
 namespace gk {
@@ -216,7 +217,7 @@ FramePair frame_pair(const Clip& clip, float time_s) {
   if (clip.loops) {
     // fmod returns an f already in [0, frames) as it is: skip the call (same bits).
     if (!(f >= 0.0f && f < static_cast<float>(frames))) {
-      f = std::fmod(f, static_cast<float>(frames));
+      f = near_fmod(f, static_cast<float>(frames));
       if (f < 0.0f) f += frames;
     }
     fp.i0 = std::min(static_cast<int>(f), frames - 1);

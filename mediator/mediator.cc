@@ -8,6 +8,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "animation/near_fmod.h"
 #include "mediator/mediator_passes.h"
 
 namespace gk {
@@ -317,7 +318,7 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
   }
   if (lod_cycles_per_s_[slot] > 0.0f) {
     const float step = lod_cycles_per_s_[slot] * pl.playback_rate[slot] * dt;
-    pl.phase[slot] = std::fmod(pl.phase[slot] + step, 1.0f);
+    pl.phase[slot] = near_fmod(pl.phase[slot] + step, 1.0f);
     lod_phase_advance_[slot] += step;
   }
   idle_time_[slot] += dt;

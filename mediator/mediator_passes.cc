@@ -6,6 +6,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "animation/near_fmod.h"
 #include "mediator/animation_plans.h"
 #include "mediator/springs.h"
 
@@ -363,13 +364,16 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
         rate = std::clamp(speed_m_s[slot] / native * cadence_scale[slot], P.min_playback_rate,
                           P.max_playback_rate);
       }
-      phase[slot] = std::fmod(phase[slot] + freq * rate * dt, 1.0f);
+      phase[slot] = near_fmod(phase[slot] + freq * rate * dt, 1.0f);
     }
     idle_time_s[slot] += dt;
     out_playback_rate[slot] = gait_w > 0.0f ? rate : 1.0f;
     out_gait_weight[slot] = gait_w;
+    // Forward clips alone sum to (+-0, y > 0), whose atan2 is that zero: no call for them.
+    const bool ahead = dir_sum.x == 0.0f && dir_sum.y > 0.0f;
     out_travel_yaw[slot] =
-        wrap_pi(lower_yaw[slot] + (gait_w > 0.0f ? std::atan2(dir_sum.x, dir_sum.y) : 0.0f));
+        wrap_pi(lower_yaw[slot] +
+                (gait_w > 0.0f ? (ahead ? dir_sum.x : std::atan2(dir_sum.x, dir_sum.y)) : 0.0f));
   });
 }
 
@@ -667,11 +671,13 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       if (lw[k] <= 0.0f) continue;
       auto wrap = [&clip](int i) { return clip.wrap_frame(i); };
       const float ft = lt[k] * clip.clip.fps;
-      const int f = wrap(static_cast<int>(std::lround(ft)));
       // Toe heights between frames (a 24 or 30 fps clip must not step the foot every other
       // frame).
       const int f0 = static_cast<int>(std::floor(ft));
       const float fu = ft - static_cast<float>(f0);
+      // The nearest frame: lround's, from the fraction (exact for ft >= 0) without the call.
+      const int f =
+          wrap(ft >= 0.0f ? f0 + (fu >= 0.5f ? 1 : 0) : static_cast<int>(std::lround(ft)));
       for (int s = 0; s < 2; ++s) {
         if (clip.gait && !clip.toe_height_m[s].empty()) {
           const auto& h = clip.toe_height_m[s];
@@ -755,13 +761,15 @@ void feedback_pass(const PassCrowd& c, bool honoured, std::span<const glm::vec2>
     // direction groups, which is no direction to hold the simulator to).
     const glm::vec2 v_out = out.velocities[a];
     const float v_out_len = glm::length(v_out);
-    const float off = wrap_pi(heading2(v_out) - psi);
     const float slack = glm::radians(P.turn_feedback_deg);
     if (!lib.has_direction_clips() && !standing[slot] && gait_weight[slot] > 0.0f &&
-        v_out_len > P.stop_speed_m_s && std::abs(off) > slack) {
-      const float dir = psi + std::clamp(off, -slack, slack);
-      out.velocities[a] = v_out_len * glm::vec2(std::sin(dir), std::cos(dir));
-      out.has_feedback[a] = 1;
+        v_out_len > P.stop_speed_m_s) {
+      const float off = wrap_pi(heading2(v_out) - psi);  // its atan2 only where it can act
+      if (std::abs(off) > slack) {
+        const float dir = psi + std::clamp(off, -slack, slack);
+        out.velocities[a] = v_out_len * glm::vec2(std::sin(dir), std::cos(dir));
+        out.has_feedback[a] = 1;
+      }
     }
     const float twist = wrap_pi(theta_raw - psi);
     const float limit = glm::radians(P.torsion_limit_deg);

@@ -8,6 +8,8 @@
 
 #include <glm/vec2.hpp>
 
+#include "animation/near_fmod.h"
+
 namespace gk {
 
 // Damping of a critically damped spring that halves its error every halflife_s seconds.
@@ -45,7 +47,7 @@ inline float wrap_pi(float a) {
   a += kPi;
   // fmod returns an x already in [0, y) as it is: skip the call (same bits).
   if (!(a >= 0.0f && a < 2.0f * kPi)) {
-    a = std::fmod(a, 2.0f * kPi);
+    a = near_fmod(a, 2.0f * kPi);
     if (a < 0.0f) a += 2.0f * kPi;
   }
   return a - kPi;
