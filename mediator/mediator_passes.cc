@@ -129,6 +129,10 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
                  std::span<uint8_t> out_standing) {
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);
+  // Without a level of detail every agent steps by dt_s: the springs' decays once for all.
+  const bool one_step = c.step_s.empty();
+  const SpringStep vel_step = spring_step(P.velocity_halflife_s, c.dt_s);
+  const SpringStep theta_step = spring_step(P.theta_halflife_s, c.dt_s);
   for_each_agent(c, [&](size_t i, int slot) {
     const float dt = c.dt(slot);
     // Sanitise what the simulator gave (NaN, absurd speeds): hold the last good values.
@@ -143,9 +147,11 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
     // Smoothed (APM only: the naive and rate modes take the simulator as it is), so a zig-zag of
     // the simulator never reaches the body.
     if (apm) {
-      critical_spring(st.vel[slot], st.vel_rate[slot], v, P.velocity_halflife_s, dt);
+      critical_spring(st.vel[slot], st.vel_rate[slot], v,
+                      one_step ? vel_step : spring_step(P.velocity_halflife_s, dt));
       const float goal = st.theta[slot] + wrap_pi(theta_raw - st.theta[slot]);
-      critical_spring(st.theta[slot], st.theta_rate[slot], goal, P.theta_halflife_s, dt);
+      critical_spring(st.theta[slot], st.theta_rate[slot], goal,
+                      one_step ? theta_step : spring_step(P.theta_halflife_s, dt));
     } else {
       st.vel[slot] = v;
       st.theta[slot] = theta_raw;
@@ -161,6 +167,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
                std::span<const float> lower_yaw, std::span<glm::vec2> root_xz,
                std::span<float> out_root_heading) {
   const bool apm = is_apm(c);
+  const bool one_step = c.step_s.empty();  // every agent steps by dt_s: one exp for all
+  const float pull = root_pull(c.dt_s);
   for_each_agent(c, [&](size_t i, int slot) {
     const float dt = c.dt(slot);
     // Predicted with the filtered velocity and pulled onto p, so a simulator's frame-to-frame
@@ -171,7 +179,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
     const glm::vec2 vel = vel_in[slot];
     glm::vec2 root_vel = vel;
     if (apm && !c.fresh[slot]) {
-      const glm::vec2 root = pulled_root(root_xz[slot], vel, p, dt);
+      const glm::vec2 root =
+          pulled_root(root_xz[slot], vel, p, dt, one_step ? pull : root_pull(dt));
       root_vel = (root - root_xz[slot]) / dt;
       root_xz[slot] = root;
     } else {

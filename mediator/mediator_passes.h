@@ -78,10 +78,6 @@ inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const 
   if (len > kMaxRootOffset) out = p + off * (kMaxRootOffset / len);
   return out;
 }
-inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const glm::vec2& p,
-                             float dt) {
-  return pulled_root(root, vel, p, dt, root_pull(dt));
-}
 
 // A layer's clip time: a gait clip's at the shared gait phase, a standing clip's on its clock, a
 // transition's on its own (`transition_time_s`).

@@ -51,10 +51,10 @@ constexpr float kDropHalflife = 0.05f;  // [s]
 constexpr float kIkMaxExtension = 0.999f;
 constexpr float kIkSoften = 0.98f;
 
-// critical_spring, skipped (its exp too) when it is at rest on a goal of 0: it would stay there.
-void settle_spring(float& x, float& v, float goal, float halflife_s, float dt) {
+// critical_spring, skipped when it is at rest on a goal of 0: it would stay there.
+void settle_spring(float& x, float& v, float goal, const SpringStep& step) {
   if (x == 0.0f && v == 0.0f && goal == 0.0f) return;
-  critical_spring(x, v, goal, halflife_s, dt);
+  critical_spring(x, v, goal, step);
 }
 
 using heel_pivot::heel_off_pivot;
@@ -311,6 +311,9 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
 void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorParams& P, float dt_s,
                           std::span<const uint8_t> detail) {
   tbb::enumerable_thread_specific<Scratch>& scratch = *scratch_;
+  drop_step_ = spring_step(kDropHalflife, dt_s);
+  heel_up_step_ = spring_step(kHeelUpHalflife, dt_s);
+  heel_down_step_ = spring_step(kHeelHalflife, dt_s);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 32), [&](const tbb::blocked_range<size_t>& r) {
     Scratch& s = scratch.local();
     for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -789,7 +792,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     if (dx < reach && dy > 0.0f) needed = std::max(needed, dy - std::sqrt(reach * reach - dx * dx));
   }
   if (pl.fresh[slot]) drop_[slot] = drop_rate_[slot] = 0.0f;
-  settle_spring(drop_[slot], drop_rate_[slot], std::min(needed, kMaxDrop), kDropHalflife, dt);
+  settle_spring(drop_[slot], drop_rate_[slot], std::min(needed, kMaxDrop), drop_step_);
   drop_[slot] = std::clamp(drop_[slot], 0.0f, kMaxDrop);
   const float drop = drop_[slot];
   glm::mat4 placed = root;
@@ -861,7 +864,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // Up fast (a heel that must rise cannot wait long), down slowly; both on springs, so the
     // ankle never turns by more in a frame than a clip's joints do.
     settle_spring(pitch, pitch_rate, reach_pitch,
-                  reach_pitch > pitch ? kHeelUpHalflife : kHeelHalflife, dt);
+                  reach_pitch > pitch ? heel_up_step_ : heel_down_step_);
     // Above the floor it must be at once (a heel below the floor is seen).
     pitch = std::max(pitch, floor_pitch);
     if (pitch > 1e-5f && glm::length(pitch_axis) > 0.5f) {

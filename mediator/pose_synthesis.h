@@ -19,6 +19,7 @@
 #include "mediator/foot_lock.h"
 #include "mediator/locomotion_library.h"
 #include "mediator/params.h"
+#include "mediator/springs.h"
 
 namespace gk {
 
@@ -156,6 +157,9 @@ class PoseSynthesizer {
   std::vector<uint8_t> prev_rot_valid_;  // local_rot_ holds a pose to measure the change against
   std::vector<float> drop_;       // pelvis drop per slot [m]
   std::vector<float> drop_rate_;  // its rate [m/s] (critically damped spring)
+  // The pelvis drop's and the heels' springs over this run's dt (every agent steps by it): their
+  // exps once per frame, set by run().
+  SpringStep drop_step_, heel_up_step_, heel_down_step_;
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
   std::vector<glm::vec2> root_offset_;  // root_offset(slot)
   FootLocks locks_;

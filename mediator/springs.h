@@ -17,14 +17,29 @@ inline float halflife_to_damping(float halflife_s) {
   return (4.0f * std::numbers::ln2_v<float>) / (halflife_s + 1e-5f);
 }
 
+// A spring's half damping y and its decay exp(-y dt) over a step of dt [s]: the same for every
+// agent stepped by the same dt and halflife, so a whole-crowd pass takes its exp once per frame.
+struct SpringStep {
+  float y = 0.0f;
+  float eydt = 1.0f;
+  float dt = 0.0f;
+};
+inline SpringStep spring_step(float halflife_s, float dt) {
+  const float y = halflife_to_damping(halflife_s) * 0.5f;
+  return {y, std::exp(-y * dt), dt};
+}
+
+template <typename T>
+inline void critical_spring(T& x, T& v, const T& goal, const SpringStep& s) {
+  const T j0 = x - goal;
+  const T j1 = v + j0 * s.y;
+  x = s.eydt * (j0 + j1 * s.dt) + goal;
+  v = s.eydt * (v - j1 * s.y * s.dt);
+}
+
 template <typename T>
 inline void critical_spring(T& x, T& v, const T& goal, float halflife_s, float dt) {
-  const float y = halflife_to_damping(halflife_s) * 0.5f;
-  const T j0 = x - goal;
-  const T j1 = v + j0 * y;
-  const float eydt = std::exp(-y * dt);
-  x = eydt * (j0 + j1 * dt) + goal;
-  v = eydt * (v - j1 * y * dt);
+  critical_spring(x, v, goal, spring_step(halflife_s, dt));
 }
 
 // 0 -> 1 with zero slope at both ends (x clamped to [0, 1]).
