@@ -1239,16 +1239,25 @@ void SkinningPaletteJob::run() const {
     return;
   }
 #if defined(__SSE2__)
-  if (stream_out && reinterpret_cast<uintptr_t>(out_palette.data()) % 16 == 0) {
+  if (!stream_out || reinterpret_cast<uintptr_t>(out_palette.data()) % 16 == 0) {
     // The arrays through locals: after a streamed store (may-alias) members would be read again.
     const float* a = &(*model.data())[0].x;
     const float* b = &(*inverse_bind.data())[0].x;
     float* m = &(*out_palette.data())[0].x;
     float* copy = fused_copy ? &(*out_model_copy.data())[0].x : nullptr;
     const float* const a_end = a + 16 * model.size();
-    // One loop per case, with the copy or without, for any affine inverse binds or translations
-    // only (the tests hoisted out of the joints' loop).
-    auto palettes = [&](auto with_copy, auto translations) __attribute__((always_inline)) {
+    // One loop per case, streamed (with the copy or without) or cached, for any affine inverse
+    // binds or translations only (the tests hoisted out of the joints' loop). The loop below's
+    // sums in its order, four lanes at once: the same bits.
+    auto palettes = [&](auto streamed, auto with_copy, auto translations)
+                        __attribute__((always_inline)) {
+      auto store = [](float* to, __m128 v) __attribute__((always_inline)) {
+        if constexpr (decltype(streamed)::value) {
+          _mm_stream_ps(to, v);
+        } else {
+          _mm_storeu_ps(to, v);
+        }
+      };
       for (; a != a_end; a += 16, b += 16, m += 16) {
         const __m128 a0 = _mm_loadu_ps(a), a1 = _mm_loadu_ps(a + 4), a2 = _mm_loadu_ps(a + 8),
                      a3 = _mm_loadu_ps(a + 12);
@@ -1260,9 +1269,9 @@ void SkinningPaletteJob::run() const {
           copy += 16;
         }
         if constexpr (decltype(translations)::value) {
-          _mm_stream_ps(m, a0);
-          _mm_stream_ps(m + 4, a1);
-          _mm_stream_ps(m + 8, a2);
+          store(m, a0);
+          store(m + 4, a1);
+          store(m + 8, a2);
         }
         for (int c = decltype(translations)::value ? 3 : 0; c < 4; ++c) {
           // The column loaded once, its entries broadcast from the register.
@@ -1271,20 +1280,26 @@ void SkinningPaletteJob::run() const {
                                              _mm_mul_ps(a1, broadcast_lane<1>(bc))),
                                   _mm_mul_ps(a2, broadcast_lane<2>(bc)));
           if (c == 3) col = _mm_add_ps(col, a3);
-          _mm_stream_ps(m + 4 * c, col);
+          store(m + 4 * c, col);
         }
       }
     };
-    if (copy && translation_inverse_bind) {
-      palettes(std::true_type{}, std::true_type{});
+    using yes = std::true_type;
+    using no = std::false_type;
+    if (!stream_out && translation_inverse_bind) {
+      palettes(no{}, no{}, yes{});
+    } else if (!stream_out) {
+      palettes(no{}, no{}, no{});
+    } else if (copy && translation_inverse_bind) {
+      palettes(yes{}, yes{}, yes{});
     } else if (copy) {
-      palettes(std::true_type{}, std::false_type{});
+      palettes(yes{}, yes{}, no{});
     } else if (translation_inverse_bind) {
-      palettes(std::false_type{}, std::true_type{});
+      palettes(yes{}, no{}, yes{});
     } else {
-      palettes(std::false_type{}, std::false_type{});
+      palettes(yes{}, no{}, no{});
     }
-    if (fence) stream_fence();
+    if (stream_out && fence) stream_fence();
     return;
   }
 #endif
