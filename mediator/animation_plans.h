@@ -23,7 +23,7 @@ struct AnimationPlans {
   // Blend layers: clip index and weight (weights sum to 1; unused layers have weight 0).
   std::vector<int16_t> layer_clip;   // [slot * kMaxBlendLayers + k]
   std::vector<float> layer_weight;   // [slot * kMaxBlendLayers + k]
-  std::vector<float> layer_time_s;   // clip time to sample
+  std::vector<float> layer_time_s;   // clip time to sample (0 in a layer of weight 0)
   std::vector<glm::vec2> root_xz;    // rendered root placement on the ground [m]
   std::vector<float> lower_yaw;      // lower-body facing psi [rad]
   std::vector<float> upper_yaw;      // desired upper-body facing (filtered theta) [rad]

@@ -333,8 +333,7 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
     // The gait phase follows the transition's own steps, as the transition pass has it.
     pl.phase[slot] = library_.transitions[tr_index_[slot]].phase_at(tr_time_[slot]);
   }
-  // Only the layers pose synthesis samples (weight > 0); the contacts pass sets them all again
-  // at the next plan.
+  // Only the layers pose synthesis samples (weight > 0), as the contacts pass.
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     if (lw[k] <= 0.0f) continue;
     lt[k] = layer_time(library_.clips[lc[k]], pl.phase[slot], idle_time_[slot], tr_time_[slot]);

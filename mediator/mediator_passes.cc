@@ -675,9 +675,14 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     }
     const bool gait_votes = moving_w >= kGaitVoteWeight;
     for (int k = 0; k < kMaxBlendLayers; ++k) {
+      // Only the layers pose synthesis samples (weight > 0) have a clip time; a standing clip's
+      // (an fmod of a clock that only grows) would otherwise be taken for every empty layer.
+      if (lw[k] <= 0.0f) {
+        lt[k] = 0.0f;
+        continue;
+      }
       const LocomotionClip& clip = lib.clips[lc[k]];
       lt[k] = layer_time(clip, phase[slot], idle_time_s[slot], transition_time_s[slot]);
-      if (lw[k] <= 0.0f) continue;
       auto wrap = [&clip](int i) { return clip.wrap_frame(i); };
       const float ft = lt[k] * clip.clip.fps;
       // Toe heights between frames (a 24 or 30 fps clip must not step the foot every other
