@@ -588,15 +588,19 @@ Status SocialForces::apply_feedback(const AgentFeedback& fb) {
                            " m, more than max_feedback_jump_m " + std::to_string(max_jump));
     }
   }
-  for (size_t i = 0; i < num_; ++i) {
-    if (!fb.has_feedback[i]) continue;
-    position_[i] = impl_->walls.constrain_move(position_[i], fb.positions[i], radius_[i]);
-    glm::vec2 v = fb.velocities[i];
-    const float s = glm::length(v);
-    if (s > max_speed_[i]) v *= max_speed_[i] / s;
-    velocity_[i] = v;
-    theta_[i] = wrap_angle(fb.thetas[i]);
-  }
+  // Each agent's own entries only (the walls are read): in parallel, as the step's passes (it is
+  // the serial end of the mediator's stage otherwise).
+  for_agents([&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      if (!fb.has_feedback[i]) continue;
+      position_[i] = impl_->walls.constrain_move(position_[i], fb.positions[i], radius_[i]);
+      glm::vec2 v = fb.velocities[i];
+      const float s = glm::length(v);
+      if (s > max_speed_[i]) v *= max_speed_[i] / s;
+      velocity_[i] = v;
+      theta_[i] = wrap_angle(fb.thetas[i]);
+    }
+  });
   return Status::Ok();
 }
 
