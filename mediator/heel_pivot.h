@@ -43,7 +43,8 @@ inline float heel_to_floor(const glm::vec3& toe, const glm::vec3& d, float ankle
   if (len < 1e-6f || toe.y + d.y >= ankle_floor) return 0.0f;
   const float now = std::asin(std::clamp(d.y / len, -1.0f, 1.0f));
   const float want = std::asin(std::clamp((ankle_floor - toe.y) / len, -1.0f, 1.0f));
-  return std::clamp(want - now, 0.0f, heel_room(d));
+  // heel_room(d), its length and asin those above.
+  return std::clamp(want - now, 0.0f, std::max(0.0f, kMaxHeelOff - now));
 }
 
 // The foot's pitch about its toe that brings the ankle within `limit` of the hip: the heel rises
