@@ -103,6 +103,7 @@ void start_step(FootLock& s, glm::vec3 from) {
   s.from = usable(from) ? from : s.last_goal;
   s.timer_s = 0.0f;
   s.offset = s.offset_vel = glm::vec3(0.0f);
+  s.offset_halflife_s = 0.0f;  // the pin it sets down settles as a landing does
 }
 
 void release(FootLock& s, glm::vec3 drawn_toe, glm::vec3 drawn_vel, glm::vec3 anim_toe,
