@@ -87,9 +87,13 @@ void plant(FootLock& s, const FootLockInput& in) {
 // to rest (moving / y ahead, y its damping over two), so the drawn foot's velocity is continuous
 // and falls off exponentially, with no overshoot. Stopped in a frame instead, a foot landing at
 // a run's swing speed snaps the ankle and knee (hundreds of m/s^2).
-void glide_to_pin(FootLock& s, const glm::vec3& moving, const FootLockParams& p) {
+void glide_to_pin(FootLock& s, glm::vec3 moving, const FootLockParams& p) {
   const float halflife = std::max(p.glide_halflife_s, 1e-3f);
   const float y = 0.5f * halflife_to_damping(halflife);
+  // No foot is carried faster than the clips' own swing (a velocity taken across a reset or a
+  // teleport is not a foot's).
+  const float speed = ground_length(moving.x, moving.z);
+  if (p.swing_speed_m_s > 0.0f && speed > p.swing_speed_m_s) moving *= p.swing_speed_m_s / speed;
   const glm::vec3 ahead = moving / y;
   s.target += ahead;
   s.offset -= ahead;
@@ -119,7 +123,8 @@ void release(FootLock& s, glm::vec3 drawn_toe, glm::vec3 drawn_vel, glm::vec3 an
   s.carry = glm::vec3(0.0f);
   s.carry_vel = glm::vec3(s.offset_vel.x, 0.0f, s.offset_vel.z);
   s.shed = s.shed_from = s.shed_goal = s.released_s = s.release_time_s = 0.0f;
-  s.swing_from = -1.0f;  // taken from the first frame's progress
+  s.offset_halflife_s = 0.0f;  // what is left of the release settles as a landing's offset
+  s.swing_from = -1.0f;        // taken from the first frame's progress
 }
 
 // This frame's transition from the state the foot was in. speed and last_speed are the clip's toe
@@ -144,9 +149,9 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
       const bool carries_weight = !in.other_locked;
       if (in.plant && (at_rest || carries_weight)) {
         // The drawn foot's velocity over the ground last frame (the goal's). It glides to its pin
-        // when pinned before it is at rest, and when it is still carried over the ground faster
-        // than the clip's ball by more than the body's own speed (twice the still speed): a
-        // released foot still shedding its offset, whose ball in the clips has landed.
+        // when pinned before it is at rest, and when it is drawn moving over the ground faster
+        // than the clip's ball by more than the body's own speed (twice the still speed), as a
+        // released foot still shedding its offset is while its ball in the clips has landed.
         const glm::vec3 moving(s.goal_vel.x, 0.0f, s.goal_vel.z);
         const bool carried = ground_length(moving.x, moving.z) > speed + 2.0f * in.still_speed_m_s;
         plant(s, in);
@@ -347,8 +352,8 @@ glm::vec3 advance_foot_lock(FootLock& s, const FootLockInput& raw, const FootLoc
   return goal;
 }
 
-FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& in,
-                            const FootLockParams& p, float dt) {
+FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& in, const FootLockParams& p,
+                            float dt) {
   FootLockStep next{state, glm::vec3(0.0f)};
   next.goal = advance_foot_lock(next.state, in, p, dt);
   return next;

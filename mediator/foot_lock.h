@@ -42,12 +42,14 @@ enum class FootLockState : uint8_t { kFree, kLocked, kReleasing, kStepping };
 // One foot's lock (explicit state; the caller stores it).
 struct FootLock {
   FootLockState state = FootLockState::kFree;
-  glm::vec3 target{0.0f};          // pinned toe (world) [m]; y is the floor
-  glm::vec3 offset{0.0f};          // inertialization offset added to the goal [m]
-  glm::vec3 offset_vel{0.0f};      // its rate [m/s]
-  float offset_halflife_s = 0.0f;  // pinned: halflife the offset decays with (0: the landing's)
-  glm::vec3 from{0.0f};            // stepping: where the step started [m]
-  float timer_s = 0.0f;            // stepping: time since the step started [s]
+  glm::vec3 target{0.0f};      // pinned toe (world) [m]; y is the floor
+  glm::vec3 offset{0.0f};      // inertialization offset added to the goal [m]
+  glm::vec3 offset_vel{0.0f};  // its rate [m/s]
+  // Pinned: halflife the offset decays with (0: the landing's release_halflife_s; a glide's
+  // shorter one settles the landing's height with it).
+  float offset_halflife_s = 0.0f;
+  glm::vec3 from{0.0f};         // stepping: where the step started [m]
+  float timer_s = 0.0f;         // stepping: time since the step started [s]
   glm::vec3 step_to{0.0f};      // stepping: where it is set down (chosen as it starts to lower) [m]
   glm::vec3 last_goal{0.0f};    // the goal returned last frame [m]
   glm::vec3 goal_vel{0.0f};     // its velocity [m/s] (a step turned release keeps its speed)

@@ -64,7 +64,10 @@ void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, fl
       // otherwise have a 1.9 m/s pedestrian float between strides).
       float even = 0.5f * (a + b);  // speed at which the two weigh the same
       if (lib.clips[c[k]].double_support && !lib.clips[c[k + 1]].double_support) {
-        even = std::clamp(lib.walk_run_speed_m_s, even, b);
+        // No further than halfway from the midpoint to the run: the run's weight still rises
+        // over a quarter of the bracket (a run clip slower than the transition speed would
+        // otherwise take all the weight in a step at its own speed).
+        even = std::clamp(lib.walk_run_speed_m_s, even, 0.5f * (even + b));
       }
       const float u = speed <= even ? 0.5f * (speed - a) / std::max(even - a, 1e-6f)
                                     : 0.5f + 0.5f * (speed - even) / std::max(b - even, 1e-6f);

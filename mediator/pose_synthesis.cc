@@ -624,7 +624,9 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
     drop_[slot] = drop_rate_[slot] = 0.0f;
     for (int side = 0; side < 2; ++side) {
       const size_t k = static_cast<size_t>(slot) * 2 + side;
-      locks_.lock[k] = FootLock();
+      // As a new agent's: drawn where it is, at rest (its last goal there, so the first goal
+      // velocity taken when the locks are next on is the foot's own, not a jump from the origin).
+      locks_.lock[k] = fresh_foot_lock(locks_.drawn_toe[k]);
       locks_.anim_toe[k] = locks_.drawn_toe[k];
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
       locks_.lift_share[k] = 0.0f;

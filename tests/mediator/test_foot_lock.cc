@@ -175,6 +175,18 @@ TEST(FootLock, AFootThatMustTakeTheWeightWhileMovingGlidesToItsPin) {
   EXPECT_NEAR(carried.goal.x - carried_from, 3.0f / y * (1.0f - std::exp(-y * kDt)), 1e-3f);
   for (int f = 0; f < 30; ++f) carried.step({x, kFloor, 0.0f}, true, true, 0.0f, true, still);
   EXPECT_NEAR(carried.goal.x - carried_from, 3.0f / y, 0.005f);
+
+  // A velocity no foot has (the clip's toe moved 30 m in a frame: a reset, a teleport) glides no
+  // further than the clips' own swing speed would carry it.
+  Foot jumped;
+  jumped.params.swing_speed_m_s = 3.0f;
+  jumped.step({0.0f, 0.03f, 0.0f}, false, false, 0.9f, false, still);
+  jumped.step({30.0f, kFloor, 0.0f}, false, false, 0.95f, false, still);
+  const float jumped_from = jumped.goal.x;
+  jumped.step({30.0f, kFloor, 0.0f}, true, true, 0.0f, false, still);
+  ASSERT_EQ(jumped.lock.state, FootLockState::kLocked);
+  for (int f = 0; f < 30; ++f) jumped.step({30.0f, kFloor, 0.0f}, true, true, 0.0f, false, still);
+  EXPECT_LE(jumped.goal.x - jumped_from, 3.0f / y + 1e-4f);
 }
 
 // A ball at rest in the clips has landed, though the blend's changing weights (a walk fading in
