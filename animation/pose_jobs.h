@@ -41,9 +41,6 @@ struct SampleClipJob {
   std::span<const JointRun> sampled_runs;
   bool validate() const;
   void run() const;
-
- private:
-  void run_runs() const;  // run() with sampled_runs (its own loops: every joint's stay as tuned)
 };
 
 // Two clips sampled and blended (weights normalised) straight into the output: the same numbers
@@ -71,9 +68,6 @@ struct SampleBlendJob {
   std::span<const JointRun> sampled_runs;
   bool validate() const;
   void run() const;
-
- private:
-  void run_runs() const;  // run() with sampled_runs (its own loops: every joint's stay as tuned)
 };
 
 // One input of a blend: a local pose and its weight (weights need not sum to 1; they are
