@@ -40,8 +40,10 @@ constexpr ParamInfo kInfos[] = {
      &P::stop_speed_m_s},
     {"foot_locking", "on/off", "pin planted feet in world space with two-bone IK", 0.0f, 1.0f,
      K::kBool, nullptr, &P::foot_locking},
-    {"lock_release_s", "s", "shortest time a released foot takes to rejoin the clip's swing", 0.02f,
-     0.5f, K::kFloat, &P::lock_release_s},
+    {"lock_release_s", "s",
+     "shortest time a released foot takes to rejoin the clip's swing (half of it: a landing's "
+     "settling halflife; a quarter: a moving foot's glide to its pin)",
+     0.02f, 0.5f, K::kFloat, &P::lock_release_s},
     {"max_leg_stretch", "x leg", "a pinned foot needing a longer leg raises its heel, then steps",
      0.9f, 1.0f, K::kFloat, &P::max_leg_stretch},
     {"idle_step_distance_m", "m", "standing: foot drift that makes the agent re-plant it", 0.02f,
