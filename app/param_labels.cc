@@ -25,6 +25,7 @@ constexpr Label kLabels[] = {
     {"max_leg_stretch", "Max leg stretch"},
     {"idle_step_distance_m", "Re-plant after drift of"},
     {"idle_step_time_s", "Re-planting step time"},
+    {"support_hold", "Hold body at support foot"},
     {"feedback", "Feedback to simulator"},
     {"turn_feedback_deg", "Max path-to-legs angle"},
     {"max_accel_m_s2", "Max speed-up"},

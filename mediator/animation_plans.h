@@ -15,6 +15,16 @@ inline constexpr int kMaxBlendLayers = 4;
 // hold, swing) and the feet walk; below it the standing clip's flags hold both feet down.
 inline constexpr float kGaitVoteWeight = 0.25f;
 
+// Where a foot that carries the body alone (pinned, the other foot not) lets the root go, as pose
+// synthesis found it on the last frame (per slot): the root more than `radius` from `centre`
+// would stretch the leg beyond its reach with the heel as high as it rises. The other foot takes
+// the weight over in `landing_s` (< 0: not known; no landing is coming soon).
+struct SupportReach {
+  glm::vec2 centre{0.0f};  // (x, z) [m]
+  float radius = -1.0f;    // [m]; < 0: no such foot
+  float landing_s = -1.0f;  // [s]
+};
+
 // Per-slot plan for one frame, read by the pose synthesis pass and the metrics.
 struct AnimationPlans {
   // Frame agent index -> slot, and slot -> frame agent index (-1 when the slot is free).

@@ -33,6 +33,9 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   plans_.layer_weight.assign(L, 0.0f);
   plans_.layer_time_s.assign(L, 0.0f);
   plans_.root_xz.assign(capacity, glm::vec2(0.0f));
+  hold_.assign(capacity, glm::vec2(0.0f));
+  hold_scale_.assign(capacity, 1.0f);
+  root_speed_.assign(capacity, 0.0f);
   plans_.lower_yaw.assign(capacity, 0.0f);
   plans_.upper_yaw.assign(capacity, 0.0f);
   plans_.travel_yaw.assign(capacity, 0.0f);
@@ -246,7 +249,8 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   filter_pass(crowd, frame, pl.root_xz, {vel_, vel_rate_, theta_, theta_rate_},
               {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
   const bool honoured = params_.feedback && policy == FeedbackPolicy::kHonoured;
-  root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_);
+  root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_,
+            support_reach_, honoured, root_speed_, hold_, hold_scale_);
   facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw, pl.upper_yaw,
               rel_dir_, pl.layer_clip, pl.layer_weight);
   weights_pass(crowd, pl.speed_m_s, rel_dir_, tr_min_cadence_, {clip_weights_, scratch_target_},
@@ -269,7 +273,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                  pl.double_support});
   feedback_pass(
       crowd, honoured, sim_pos_, sim_vel_, sim_theta_, fed_speed_, pl.lower_yaw, pl.standing,
-      pl.gait_weight,
+      pl.gait_weight, hold_, hold_scale_,
       {feedback_.has_feedback, feedback_.positions, feedback_.velocities, feedback_.thetas});
   if (lod) {
     for (size_t i = 0; i < n; ++i) {

@@ -59,6 +59,7 @@ class Mediator {
   // whole time since its last plan. Empty (the default): every agent every frame. The span must
   // stay valid (capacity long) while it is set.
   void set_lod_due(std::span<const uint8_t> due_by_slot) { lod_due_ = due_by_slot; }
+  void set_support_reach(std::span<const SupportReach> by_slot) { support_reach_ = by_slot; }
 
   const AnimationPlans& plans() const { return plans_; }
   const FeedbackBuffers& feedback() const { return feedback_; }
@@ -135,6 +136,10 @@ class Mediator {
   // LOD, per slot: whether it is planned this frame, the step it is planned over [s], and the
   // time [s], phase and root advance since its last plan.
   std::span<const uint8_t> lod_due_;
+  std::span<const SupportReach> support_reach_;
+  std::vector<glm::vec2> hold_;
+  std::vector<float> hold_scale_;
+  std::vector<float> root_speed_;  // the drawn root's speed last frame [m/s]
   std::vector<uint8_t> lod_plan_;
   std::vector<float> lod_dt_s_;
   std::vector<float> lod_elapsed_s_, lod_phase_advance_, lod_tr_advance_;

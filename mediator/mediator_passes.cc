@@ -168,7 +168,9 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
 void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
                std::span<const glm::vec2> vel_in, std::span<const uint8_t> standing,
                std::span<const float> lower_yaw, std::span<glm::vec2> root_xz,
-               std::span<float> out_root_heading) {
+               std::span<float> out_root_heading, std::span<const SupportReach> support_reach,
+               bool honoured, std::span<float> root_speed, std::span<glm::vec2> out_hold,
+               std::span<float> out_hold_scale) {
   const bool apm = is_apm(c);
   const bool one_step = c.step_s.empty();  // every agent steps by dt_s: one exp for all
   const float pull = root_pull(c.dt_s);
@@ -181,14 +183,57 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
     const glm::vec2 p = positions[i];
     const glm::vec2 vel = vel_in[slot];
     glm::vec2 root_vel = vel;
+    out_hold[slot] = glm::vec2(0.0f);
+    out_hold_scale[slot] = 1.0f;
     if (apm && !c.fresh[slot]) {
-      const glm::vec2 root =
-          pulled_root(root_xz[slot], vel, p, dt, one_step ? pull : root_pull(dt));
+      glm::vec2 root = pulled_root(root_xz[slot], vel, p, dt, one_step ? pull : root_pull(dt));
+      // A foot that carries the body alone holds it back (a source that takes feedback only:
+      // one that does not would just be caught up with later). Until the other foot comes down
+      // the root may cover what is left of the support leg's reach, no more: its speed away from
+      // the foot is cut to that gap over the time to the landing (with no landing in sight, to
+      // what still stops it at the edge braking at kSupportBrake), the whole step scaled so the
+      // body keeps its direction, and never braked harder than kSupportBrake (beyond, the foot
+      // gives, as before); never backward, never further than kMaxRootOffset from p. The
+      // simulator is given the held position and the speed the body kept (feedback_pass).
+      if (honoured && c.params.support_hold && !support_reach.empty() &&
+          support_reach[slot].radius >= 0.0f) {
+        const SupportReach& sr = support_reach[slot];
+        const glm::vec2 prev = root_xz[slot];
+        const glm::vec2 from_foot = prev - sr.centre;
+        const float dist = glm::length(from_foot);
+        const glm::vec2 step = root - prev;
+        const float away = dist > 1e-6f ? glm::dot(step, from_foot) / dist : 0.0f;
+        const float gap = std::max(0.0f, sr.radius - dist);
+        float allowed;
+        if (sr.landing_s > 0.0f) {
+          allowed = gap * std::min(1.0f, dt / sr.landing_s);
+        } else {
+          // The speed from which braking frame by frame covers the gap: v dt + (v - a dt) dt +
+          // ... = v^2 / 2a + v dt / 2.
+          const float half = 0.5f * kSupportBrake * dt;
+          allowed = std::min(gap, (std::sqrt(half * half + 2.0f * kSupportBrake * gap) - half) * dt);
+        }
+        if (away > allowed) {
+          // No harder a brake than kSupportBrake from the root's own speed last frame.
+          const float speed = glm::length(step) / dt;
+          const float floor_speed = root_speed[slot] - kSupportBrake * dt;
+          const float scale = std::clamp(
+              std::max(allowed / away, speed > 1e-4f ? floor_speed / speed : 0.0f), 0.0f, 1.0f);
+          out_hold_scale[slot] = scale;
+          glm::vec2 held = prev + step * scale;
+          const glm::vec2 off = held - p;
+          const float off_len = glm::length(off);
+          if (off_len > kMaxRootOffset) held = p + off * (kMaxRootOffset / off_len);
+          out_hold[slot] = held - root;
+          root = held;
+        }
+      }
       root_vel = (root - root_xz[slot]) / dt;
       root_xz[slot] = root;
     } else {
       root_xz[slot] = p;
     }
+    root_speed[slot] = glm::length(root_vel);
     out_root_heading[slot] =
         standing[slot] ? lower_yaw[slot] : heading2(glm::length(root_vel) > 1e-3f ? root_vel : vel);
   });
@@ -738,13 +783,14 @@ void feedback_pass(const PassCrowd& c, bool honoured, std::span<const glm::vec2>
                    std::span<const glm::vec2> velocities, std::span<const float> thetas,
                    std::span<float> fed_speed, std::span<const float> lower_yaw,
                    std::span<const uint8_t> standing, std::span<const float> gait_weight,
+                   std::span<const glm::vec2> hold, std::span<const float> hold_scale,
                    FeedbackOut out) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);
   for_each_agent(c, [&](size_t a, int slot) {
     // The speed and torso orientation the animation can deliver.
-    const glm::vec2 v = velocities[a];
+    glm::vec2 v = velocities[a];
     const float theta_raw = thetas[a];
     const float psi = lower_yaw[slot];
     out.has_feedback[a] = 0;
@@ -754,6 +800,14 @@ void feedback_pass(const PassCrowd& c, bool honoured, std::span<const glm::vec2>
     const float fed_before = fed_speed[slot];
     fed_speed[slot] = glm::length(v);
     if (!(apm && honoured)) return;
+    // The root held back by a support foot (root_pass): the simulator's agent is held with it,
+    // at the speed it kept (the speed-up below then starts from there: no lurch when it lets go).
+    if (hold[slot] != glm::vec2(0.0f)) {
+      out.positions[a] = positions[a] + hold[slot];
+      v *= std::clamp(hold_scale[slot], 0.0f, 1.0f);
+      out.velocities[a] = v;
+      out.has_feedback[a] = 1;
+    }
     const DirectionGroup& fg = lib.groups[lib.forward_group];
     const float max_speed =
         lib.clips[fg.clips.back()].speed_m_s * P.max_playback_rate * (1.0f + P.max_stride_warp);

@@ -25,6 +25,7 @@
 #include <glm/vec2.hpp>
 
 #include "crowd/crowd_source.h"
+#include "mediator/animation_plans.h"
 #include "mediator/locomotion_library.h"
 #include "mediator/params.h"
 
@@ -52,6 +53,9 @@ struct PassCrowd {
 // The drawn root: pulled onto p this fast, and never further from it.
 inline constexpr float kRootPullTime = 0.25f;   // [s]
 inline constexpr float kMaxRootOffset = 0.06f;  // [m]
+// A root held back by its support foot brakes no harder than this (about g: what friction lets
+// legs put on a body) [m/s^2].
+inline constexpr float kSupportBrake = 9.81f;
 
 // The simulator's values are garbage beyond these (NaN, 1e30, a velocity no body has).
 inline constexpr float kAbsurdSpeed = 15.0f;   // [m/s]
@@ -130,14 +134,20 @@ void filter_pass(const PassCrowd& crowd, const AgentFrame& frame,
                  std::span<float> out_speed_m_s, std::span<uint8_t> out_standing);
 
 // --- root ---------------------------------------------------------------------------------------
-// Reads the sanitised positions (per agent), the filtered velocity, `standing` and last frame's
-// lower-body yaw. Writes the drawn root (predicted with the filtered velocity and pulled onto p,
-// never far from it) and its heading, the direction it travels [rad] (the lower body's yaw when
-// standing).
+// Reads the sanitised positions (per agent), the filtered velocity, `standing`, last frame's
+// lower-body yaw and support reach (per slot, PoseSynthesizer::support_reach; empty: none).
+// Writes the drawn root (predicted with the filtered velocity and pulled onto p, never far from
+// it; with MediatorParams::support_hold, slowed where it would leave the reach of a foot that
+// carries the body alone) and its heading, the direction it travels [rad] (the lower body's yaw
+// when standing), per slot its speed (root_speed: last frame's in, this frame's out) [m/s], and
+// the hold: how far the root was held back [m] and the share of its step it kept (both fed
+// back).
 void root_pass(const PassCrowd& crowd, std::span<const glm::vec2> positions,
                std::span<const glm::vec2> vel, std::span<const uint8_t> standing,
                std::span<const float> lower_yaw, std::span<glm::vec2> root_xz,
-               std::span<float> out_root_heading);
+               std::span<float> out_root_heading, std::span<const SupportReach> support_reach,
+               bool honoured, std::span<float> root_speed, std::span<glm::vec2> out_hold,
+               std::span<float> out_hold_scale);
 
 // --- facing -------------------------------------------------------------------------------------
 // Reads the root's heading, the filtered theta, `standing` and last frame's layers. Writes the
@@ -267,7 +277,9 @@ struct FeedbackOut {
 // Reads the sanitised input (per agent), the lower-body yaw, `standing` and the share of gait
 // clips; fed_speed (per slot) is the speed the simulator was given last frame, and is updated.
 // Writes the feedback (per agent): the sanitised input, unflagged, unless `honoured` (APM with
-// feedback on and a source that takes it) and the animation cannot deliver it: a speed-up faster
+// feedback on and a source that takes it) and the animation cannot deliver it: a root held back
+// by its support foot (`hold` and `hold_scale`, per slot: the position moves with it and the
+// velocity keeps the share of the step the root kept), a speed-up faster
 // than max_accel_m_s2 over fed_speed, a speed above the fastest clip's reach, with forward
 // clips only a velocity turning away from psi faster than the legs, or a theta beyond the torsion
 // limit.
@@ -275,6 +287,7 @@ void feedback_pass(const PassCrowd& crowd, bool honoured, std::span<const glm::v
                    std::span<const glm::vec2> velocities, std::span<const float> thetas,
                    std::span<float> fed_speed, std::span<const float> lower_yaw,
                    std::span<const uint8_t> standing, std::span<const float> gait_weight,
+                   std::span<const glm::vec2> hold, std::span<const float> hold_scale,
                    FeedbackOut out);
 
 }  // namespace gk

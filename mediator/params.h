@@ -40,6 +40,9 @@ struct MediatorParams {
   float idle_step_distance_m =
       0.12f;                       // [m] [Limit: 0.02..0.5] planted-foot drift that triggers a step
   float idle_step_time_s = 0.35f;  // [s] [Limit: 0.1..1] duration of a re-planting step
+  // The root never leaves the reach of a foot that carries the body alone (the other in the
+  // air): it slows as that leg straightens, and the simulator is given the held position.
+  bool support_hold = true;
   // 8. Feedback to the simulator.
   bool feedback = true;
   float turn_feedback_deg = 10.0f;  // [deg] [Limit: 0..180] forward-only libraries: velocity kept
@@ -53,6 +56,10 @@ struct MediatorParams {
   uint64_t seed = 1;
   MediatorMode mode = MediatorMode::kApm;
 };
+
+// Halflife of the glide of a foot pinned while it still moves over the ground [s] (a quarter of
+// lock_release_s: loaded, a foot stops faster than a landing one settles).
+inline float glide_halflife_s(const MediatorParams& p) { return 0.25f * p.lock_release_s; }
 
 // Descriptor of one parameter for the CLI and the panel.
 struct ParamInfo {

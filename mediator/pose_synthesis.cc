@@ -118,6 +118,8 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   drop_rate_.assign(capacity, 0.0f);
   placed_xz_.assign(capacity, glm::vec2(0.0f));
   root_offset_.assign(capacity, glm::vec2(0.0f));
+  support_reach_.assign(capacity, SupportReach{});
+  swing_prev_.assign(capacity * 2, 0.0f);
   locks_.lock.assign(capacity * 2, FootLock());
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
@@ -382,6 +384,7 @@ void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
   const glm::vec2 offset = pl.root_xz[slot] - placed_xz_[slot];
   const glm::vec2 delta = offset - root_offset_[slot];
   root_offset_[slot] = offset;
+  support_reach_[slot] = SupportReach{};  // its feet were not looked at
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     locks_.drawn_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
@@ -549,6 +552,7 @@ void PoseSynthesizer::synthesize_agent(const AnimationPlans& pl, const MediatorP
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   placed_xz_[slot] = pl.root_xz[slot];
   root_offset_[slot] = glm::vec2(0.0f);
+  support_reach_[slot] = SupportReach{};
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   const bool twisting = apm && detail != PoseDetail::kLight;
   if (twisting && can_twist_) {
@@ -713,9 +717,10 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                                 const glm::mat4& root, float dt, bool letting_go) {
   const FootLockParams lp{0.5f * P.lock_release_s, P.idle_step_distance_m, P.idle_step_time_s,
                           library_.swing_height_m, library_.swing_speed_m_s, P.lock_release_s,
-                          0.25f * P.lock_release_s};
+                          glide_halflife_s(P)};
   glm::vec3 goal[2], anim_toe[2], anim_vel[2];
   bool pinned[2] = {false, false};
+  float swing_before[2];  // each foot's swing progress last frame
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     // The clip's toe, no lower than the gait clips alone have it: a walk blended with a standing
@@ -776,6 +781,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     anim_vel[side] = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
 
     locks_.anim_toe[k] = anim_toe[side];
+    swing_before[side] = swing_prev_[k];
+    swing_prev_[k] = pl.swing_progress[side][slot];
     const FootLockState st = locks_.lock[k].state;
     pinned[side] = st == FootLockState::kLocked || st == FootLockState::kStepping;
   }
@@ -873,6 +880,32 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       const glm::quat r = glm::angleAxis(pitch, pitch_axis);
       goal_ankle = toe_goal + r * d;
       ankle_world_rot[side] = r * ankle_world_rot[side];
+    }
+    if (!letting_go && locks_.lock[k].state == FootLockState::kLocked &&
+        locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state != FootLockState::kLocked) {
+      // This foot carries the body alone: the hip can go no further from it than the leg reaches
+      // with the heel as high as it rises (the mediator holds the root within that next frame,
+      // MediatorParams::support_hold).
+      glm::vec3 far_ankle = goal_ankle;
+      if (glm::length(pitch_axis) > 0.5f) {
+        far_ankle = toe_goal + glm::angleAxis(heel_pivot::heel_room(d), pitch_axis) * d;
+      }
+      const float dy = hip_p.y - far_ankle.y;
+      const float r = limit > dy ? std::sqrt(limit * limit - dy * dy) : 0.0f;
+      SupportReach& sr = support_reach_[slot];
+      sr.centre = glm::vec2(far_ankle.x - (hip_p.x - placed[3].x),
+                            far_ankle.z - (hip_p.z - placed[3].z));
+      sr.radius = r;
+      // When the other foot comes down: a re-planting step when its time is up; a foot in the
+      // clips' swing when its progress, at its rate over the last frame, reaches 1.
+      const FootLock& other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)];
+      const float progress = pl.swing_progress[1 - side][slot];
+      const float rate = (progress - swing_before[1 - side]) / dt;
+      if (other.state == FootLockState::kStepping) {
+        sr.landing_s = std::max(0.0f, lp.step_time_s - other.timer_s);
+      } else if (!pl.fresh[slot] && rate > 1e-3f && progress > 0.0f && progress < 1.0f) {
+        sr.landing_s = (1.0f - progress) / rate;
+      }
     }
     if (glm::length(goal_ankle - hip_p) > limit + 1e-3f &&
         locks_.lock[k].state == FootLockState::kLocked) {

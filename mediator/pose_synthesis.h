@@ -70,6 +70,10 @@ class PoseSynthesizer {
   // last pose. A held agent costs O(1) this way, not a move of every joint's matrix.
   glm::vec2 root_offset(int slot) const { return root_offset_[slot]; }
   std::span<const glm::vec2> root_offsets() const { return root_offset_; }
+  // Per slot, where a foot that carries the body alone (pinned, the other foot not) lets the root
+  // go, and when the other foot comes down (SupportReach): the mediator holds the root within
+  // that reach until then (and feeds the held position back), so the support foot stays pinned.
+  std::span<const SupportReach> support_reach() const { return support_reach_; }
   // One joint's world position as drawn this frame (world(slot)'s translation + root_offset).
   glm::vec3 joint_position(int slot, int joint) const {
     const glm::vec4& t = world_[static_cast<size_t>(slot) * num_joints_ + joint][3];
@@ -161,7 +165,9 @@ class PoseSynthesizer {
   // exps once per frame, set by run().
   SpringStep drop_step_, heel_up_step_, heel_down_step_;
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
-  std::vector<glm::vec2> root_offset_;  // root_offset(slot)
+  std::vector<glm::vec2> root_offset_;    // root_offset(slot)
+  std::vector<SupportReach> support_reach_;  // support_reach()
+  std::vector<float> swing_prev_;            // per foot: its swing progress last frame
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   std::vector<int> subtree_end_;  // subtree_ends(skeleton_)

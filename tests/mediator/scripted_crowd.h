@@ -1,7 +1,8 @@
 #pragma once
 // A CrowdSource whose agents follow scripted velocity and theta functions of time: straight walks,
 // speed ramps, turns on the spot, looking aside. Positions integrate the velocities exactly, so the
-// expected root path is known independently of the mediator.
+// expected root path is known independently of the mediator (a crowd that honours feedback takes
+// the fed-back position, velocity and theta, as a simulator does).
 
 #include <functional>
 #include <string>
@@ -51,6 +52,7 @@ class ScriptedCrowd : public CrowdSource {
       if (!fb.has_feedback[i]) continue;
       ++last_feedback_count_;
       if (honour_) {
+        p_[i] = fb.positions[i];
         v_[i] = fb.velocities[i];
         th_[i] = fb.thetas[i];
       }

@@ -22,8 +22,8 @@ namespace {
 constexpr float kDt = 1.0f / 60.0f;
 constexpr int kFrames = 600;
 
-MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, MediatorMode mode) {
-  MediatorParams params;
+MetricsReport run_source(CrowdSource& crowd, const LocomotionLibrary& lib, MediatorMode mode,
+                         MediatorParams params = {}) {
   params.mode = mode;
   CrowdPipeline pipeline(lib, params, test::test_pipeline_options(crowd.capacity(), kDt));
   for (int f = 0; f < kFrames; ++f) {
@@ -108,9 +108,9 @@ TEST(Quality, GalleryUpperBodyFacesTheExhibits) {
 
 // The hardest simulated case: a jam in DetourCrowd (velocities that flip sideways from frame to
 // frame) animated with a library of just two clips by different actors (CMU walk and run). Not
-// yet within the support-slide, float and limb-pop bounds (bench/quality.md has the
-// figures); what holds: the body bounds, no foot below the floor, the support foot skating a
-// tenth of naive's at most, and far fewer limb snaps than naive's.
+// yet always within the support skate and limb-pop bounds (bench/quality.md has the
+// figures); what holds: the body bounds, no foot below the floor, the support slide bound, and
+// far fewer limb snaps than naive's.
 TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
   GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
   GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
@@ -123,8 +123,36 @@ TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
   const MetricsReport naive = run_source(*b, *lib, MediatorMode::kNaive);
   expect_body_bounds(apm, false, "bottleneck detour cmu");
   expect_feet_never_below_the_floor(apm, naive, "bottleneck detour cmu");
+  EXPECT_LE(apm.feet.support_slide_cm_s, 2.0);
   EXPECT_LE(10.0 * apm.feet.limb_pop_rate, naive.feet.limb_pop_rate);
   EXPECT_LE(apm.feet.gmd_skate_ratio, apm.feet_floor.gmd_skate_ratio + 0.002);
+}
+
+// The same jam with the mannequin's keyframed clips: within the support-foot and limb-pop bounds,
+// and it is the support hold that keeps the support feet put (without it, a foot carrying the
+// body alone is dragged or let go as the body lurches on: support skate 0.0057 against 0.0039,
+// float 0.016 against 0.010, the float at its bound here; bench/quality.md's run of the same
+// scene meets it).
+TEST(Quality, JammedBodiesAreHeldByTheirSupportFoot) {
+  GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
+  auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  auto a = scenario_crowd("bottleneck", true);
+  auto b = scenario_crowd("bottleneck", true);
+  auto c = scenario_crowd("bottleneck", true);
+  const MetricsReport apm = run_source(*a, *lib, MediatorMode::kApm);
+  expect_body_bounds(apm, false, "bottleneck detour mannequin");
+  expect_feet_never_below_the_floor(apm, run_source(*b, *lib, MediatorMode::kNaive),
+                                    "bottleneck detour mannequin");
+  EXPECT_LE(apm.feet.support_slide_cm_s, 2.0);
+  EXPECT_LE(apm.feet.support_skate_ratio, 0.005);
+  EXPECT_LE(apm.feet.limb_pop_rate, 1.0);
+  EXPECT_EQ(apm.pop_count, 0);
+  MediatorParams no_hold;
+  no_hold.support_hold = false;
+  const MetricsReport unheld = run_source(*c, *lib, MediatorMode::kApm, no_hold);
+  EXPECT_GT(unheld.feet.support_skate_ratio, 1.25 * apm.feet.support_skate_ratio);
+  EXPECT_GT(unheld.feet.float_ratio, 1.4 * apm.feet.float_ratio);
 }
 
 // Captured clips of another kind (CMU subject 16: 30 fps, centimetres, a start, a stop, turns and

@@ -1,0 +1,209 @@
+// A foot that carries the body alone holds it back (issue #9: in a Detour jam the simulator's
+// velocity lurches faster than legs can follow, and the support foot was dragged along or let go
+// while the other was in the air). The root pass brakes the root as the support leg straightens
+// (no harder than kSupportBrake), never lets it leave the leg's reach, keeps its direction, and
+// the feedback gives the simulator the held position and the speed kept.
+
+#include <cmath>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "mediator/mediator_passes.h"
+#include "tests/mediator/mediator_fixture.h"
+
+namespace gk {
+namespace {
+
+constexpr float kDt = 1.0f / 60.0f;
+
+// One agent in slot 0, walking along +z, its support foot's reach a circle about `centre`.
+struct OneAgent {
+  const LocomotionLibrary& lib = test::builtin_library();
+  MediatorParams params;
+  std::vector<int32_t> slot_of_agent{0};
+  std::vector<uint8_t> fresh{0};
+  std::vector<glm::vec2> positions{glm::vec2(0.0f, 1.0f)};
+  std::vector<glm::vec2> vel{glm::vec2(0.0f, 1.2f)};
+  std::vector<uint8_t> standing{0};
+  std::vector<float> lower_yaw{0.0f};
+  std::vector<glm::vec2> root_xz{glm::vec2(0.0f, 0.98f)};
+  std::vector<float> root_heading{0.0f};
+  // The leg lets the root go 0.49 m from (0, 0.5); no landing of the other foot in sight.
+  std::vector<SupportReach> reach{SupportReach{glm::vec2(0.0f, 0.5f), 0.49f, -1.0f}};
+  std::vector<glm::vec2> hold{glm::vec2(0.0f)};
+  std::vector<float> hold_scale{1.0f};
+  std::vector<float> root_speed{1.2f};
+
+  // One root pass; returns the root it drew.
+  glm::vec2 root_step(bool honoured, bool with_reach = true) {
+    const PassCrowd crowd{lib, params, kDt, slot_of_agent, fresh};
+    root_pass(crowd, positions, vel, standing, lower_yaw, root_xz, root_heading,
+              with_reach ? std::span<const SupportReach>(reach) : std::span<const SupportReach>(),
+              honoured, root_speed, hold, hold_scale);
+    return root_xz[0];
+  }
+};
+
+glm::vec2 unheld_root(const OneAgent& a) {
+  return pulled_root(a.root_xz[0], a.vel[0], a.positions[0], kDt, root_pull(kDt));
+}
+
+TEST(SupportHold, TheRootSlowsWithinTheReachAndKeepsItsDirection) {
+  OneAgent a;
+  a.reach[0].radius = 0.55f;  // 7 cm left: about what braking at kSupportBrake from 1.2 m/s takes
+  const glm::vec2 prev = a.root_xz[0];
+  const glm::vec2 free_root = unheld_root(a);
+  const glm::vec2 centre = a.reach[0].centre;
+  // Free, the root would come closer to the edge than it can still stop in.
+  ASSERT_GT(glm::length(free_root - centre), 0.49f);
+  const glm::vec2 root = a.root_step(/*honoured=*/true);
+  EXPECT_LE(glm::length(root - centre), a.reach[0].radius);
+  const glm::vec2 step = root - prev, free_step = free_root - prev;
+  EXPECT_GT(glm::dot(step, glm::normalize(free_step)), 0.0f);  // slowed, not stopped
+  EXPECT_LT(glm::length(step), glm::length(free_step));
+  // The same direction: the lower body's travel (and the heading metric) does not swing.
+  EXPECT_NEAR(step.x * free_step.y - step.y * free_step.x, 0.0f, 1e-7f);
+  // The hold is what the root was held back by, and the simulator is given it.
+  EXPECT_NEAR(glm::length(a.hold[0] - (root - free_root)), 0.0f, 1e-6f);
+  std::vector<uint8_t> has(1, 0);
+  std::vector<glm::vec2> fb_p(1), fb_v(1);
+  std::vector<float> fb_theta(1), fed_speed{1.2f}, gait_weight{1.0f}, thetas{0.0f};
+  const PassCrowd crowd{a.lib, a.params, kDt, a.slot_of_agent, a.fresh};
+  feedback_pass(crowd, true, a.positions, a.vel, thetas, fed_speed, a.lower_yaw, a.standing,
+                gait_weight, a.hold, a.hold_scale, {has, fb_p, fb_v, fb_theta});
+  EXPECT_EQ(has[0], 1);
+  EXPECT_NEAR(glm::length(fb_p[0] - (a.positions[0] + a.hold[0])), 0.0f, 1e-6f);
+  // With the speed the body kept: the share of its step, along the same direction.
+  const float kept = glm::length(step) / glm::length(free_step);
+  EXPECT_NEAR(glm::length(fb_v[0] - a.vel[0] * kept), 0.0f, 1e-5f);
+}
+
+// Pushed on frame after frame, the body comes to rest at the edge of the leg's reach with its
+// speed falling every frame, never faster than kSupportBrake (no jolt), and the simulator's agent
+// stays with the drawn root.
+TEST(SupportHold, APushedBodyComesToRestAtTheEdgeOfTheReach) {
+  OneAgent a;
+  a.root_xz[0] = glm::vec2(0.0f, 0.80f);  // 19 cm from the edge, walking at 1.2 m/s
+  a.positions[0] = glm::vec2(0.0f, 0.80f);
+  const glm::vec2 centre = a.reach[0].centre;
+  float last_speed = 1e9f;
+  int held = 0;
+  for (int f = 0; f < 45; ++f) {
+    const glm::vec2 prev = a.root_xz[0];
+    const glm::vec2 root = a.root_step(true);
+    const float speed = glm::length(root - prev) / kDt;
+    EXPECT_LE(glm::length(root - centre), a.reach[0].radius + 1e-4f) << f;
+    if (a.hold[0] != glm::vec2(0.0f)) {  // from the first hold on
+      EXPECT_LE(speed, last_speed + 1e-4f) << f;
+      if (last_speed < 1e8f) {
+        EXPECT_LE((last_speed - speed) / kDt, kSupportBrake * 1.01f) << f;
+      }
+      last_speed = speed;
+      ++held;
+    }
+    a.positions[0] += a.hold[0];                 // the simulator takes the held position
+    EXPECT_LE(glm::length(root - a.positions[0]), kMaxRootOffset + 1e-6f) << f;
+    a.positions[0] += a.vel[0] * kDt;            // and pushes on
+  }
+  EXPECT_LT(a.reach[0].radius - glm::length(a.root_xz[0] - centre), 1e-3f);
+  EXPECT_GT(held, 20);
+  EXPECT_LT(last_speed, 0.05f);
+}
+
+TEST(SupportHold, NothingIsHeldWithoutFeedbackOrWhenOff) {
+  {
+    OneAgent a;  // a source that ignores feedback (a replay): the root would only lag p
+    const glm::vec2 free_root = unheld_root(a);
+    EXPECT_EQ(a.root_step(/*honoured=*/false), free_root);
+    EXPECT_EQ(a.hold[0], glm::vec2(0.0f));
+  }
+  {
+    OneAgent a;
+    a.params.support_hold = false;
+    const glm::vec2 free_root = unheld_root(a);
+    EXPECT_EQ(a.root_step(true), free_root);
+    EXPECT_EQ(a.hold[0], glm::vec2(0.0f));
+  }
+  {
+    OneAgent a;  // no foot carries the body alone
+    a.reach[0].radius = -1.0f;
+    EXPECT_EQ(a.root_step(true), unheld_root(OneAgent{}));
+  }
+  {
+    OneAgent a;  // no reach given (a mediator without pose synthesis)
+    const glm::vec2 free_root = unheld_root(a);
+    EXPECT_EQ(a.root_step(true, /*with_reach=*/false), free_root);
+  }
+  {
+    OneAgent a;  // moving toward the foot is never held
+    a.vel[0] = glm::vec2(0.0f, -1.2f);
+    a.positions[0] = glm::vec2(0.0f, 0.96f);
+    const glm::vec2 free_root = unheld_root(a);
+    EXPECT_EQ(a.root_step(true), free_root);
+  }
+}
+
+// The other foot comes down in time: the root walks on unheld (a steady walk's late stance).
+// Not in time: it covers what is left of the reach by the landing, at an even speed.
+TEST(SupportHold, TheRootMayUseTheReachUntilTheOtherFootLands) {
+  {
+    OneAgent a;
+    a.reach[0].radius = 0.60f;     // 12 cm left
+    a.reach[0].landing_s = 0.05f;  // 3 frames: 6 cm at 1.2 m/s
+    const glm::vec2 free_root = unheld_root(a);
+    EXPECT_EQ(a.root_step(true), free_root);
+    EXPECT_EQ(a.hold[0], glm::vec2(0.0f));
+  }
+  {
+    OneAgent a;  // at 0.6 m/s
+    a.vel[0] = glm::vec2(0.0f, 0.6f);
+    a.root_speed[0] = 0.6f;
+    a.positions[0] = glm::vec2(0.0f, 0.99f);
+    a.reach[0].radius = 0.52f;     // 4 cm left
+    a.reach[0].landing_s = 0.1f;   // 6 frames: 6 cm at 0.6 m/s
+    const glm::vec2 centre = a.reach[0].centre;
+    float speed[6];
+    for (int f = 0; f < 6; ++f) {
+      const glm::vec2 prev = a.root_xz[0];
+      a.root_step(true);
+      speed[f] = glm::length(a.root_xz[0] - prev) / kDt;
+      a.positions[0] += a.hold[0] + a.vel[0] * kDt;
+      a.reach[0].landing_s -= kDt;
+    }
+    // 4 cm in 0.1 s: about 0.4 m/s to the landing, after a brake no harder than kSupportBrake.
+    EXPECT_LE(glm::length(a.root_xz[0] - centre), a.reach[0].radius + 1e-4f);
+    EXPECT_GT(glm::length(a.root_xz[0] - centre), a.reach[0].radius - 5e-3f);
+    EXPECT_GE(speed[0], 0.6f - kSupportBrake * kDt - 1e-3f);
+    EXPECT_NEAR(speed[5], 0.04f / 0.1f, 0.1f);
+  }
+}
+
+// A root already beyond the reach (the foot was pinned behind a lurch) goes no further from the
+// foot if it has come to rest, and is not pulled back toward it either: it waits for the other
+// foot. One still moving is not stopped dead: it brakes at kSupportBrake, and the foot gives.
+TEST(SupportHold, ARootBeyondTheReachNeverMovesBackwardNorStopsDead) {
+  {
+    OneAgent a;
+    a.root_xz[0] = glm::vec2(0.0f, 1.03f);
+    a.positions[0] = glm::vec2(0.0f, 1.05f);
+    a.root_speed[0] = 0.0f;
+    const glm::vec2 prev = a.root_xz[0];
+    const glm::vec2 root = a.root_step(true);
+    EXPECT_NEAR(glm::length(root - prev), 0.0f, 1e-6f);
+  }
+  {
+    OneAgent a;
+    a.root_xz[0] = glm::vec2(0.0f, 1.03f);
+    a.positions[0] = glm::vec2(0.0f, 1.05f);
+    const glm::vec2 prev = a.root_xz[0];
+    const glm::vec2 free_root = unheld_root(a);
+    const glm::vec2 root = a.root_step(true);
+    EXPECT_NEAR(glm::length(root - prev) / kDt, 1.2f - kSupportBrake * kDt, 1e-3f);
+    EXPECT_LT(glm::length(root - prev), glm::length(free_root - prev));
+  }
+}
+
+}  // namespace
+}  // namespace gk
