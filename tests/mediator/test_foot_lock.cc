@@ -528,30 +528,6 @@ TEST(FootLock, StepSetsTheFootDownWhereItWasCarried) {
   EXPECT_NEAR(horizontal(foot.step(anim, false, true), landed), 0.0f, 1e-6f);
 }
 
-// The clip's foot jumps 6 cm in one frame late in a re-planting step (a blend's weights moving as
-// gait clips fade in): the carried foot follows it on a spring, not in that frame, and sets down
-// where it was carried to by then, toward the clip's foot.
-TEST(FootLock, AStepFollowsAJumpingClipFootWithoutAJump) {
-  Foot foot;
-  const glm::vec3 from(0.0f, kFloor, 0.0f);
-  glm::vec3 anim(0.2f, kFloor, 0.0f);
-  foot.step(from, true, true);
-  foot.lock = start_foot_step(foot.lock, foot.goal);
-  float largest = 0.0f;
-  for (int k = 1; k <= 40 && foot.lock.state == FootLockState::kStepping; ++k) {
-    if (k == 14) anim += glm::vec3(0.06f, 0.0f, 0.0f);  // u = 2/3 of the step
-    const glm::vec3 prev = foot.goal;
-    foot.step(anim, false, true);
-    largest = std::max(largest, horizontal(foot.goal, prev));
-  }
-  ASSERT_EQ(foot.lock.state, FootLockState::kLocked);
-  // The carry's own pace: 0.2 m over the middle 0.21 s, at most 1.5 times its mean under the
-  // smoothstep, 2.4 cm a frame; the jump taken in one frame would add about 5 cm to one of them.
-  EXPECT_LT(largest, 0.03f);
-  EXPECT_GT(foot.goal.x, 0.2f + 0.01f);
-  EXPECT_LT(foot.goal.x, anim.x + 1e-6f);
-}
-
 // Released 0.75 m from a clip toe that stands still (a foot left behind in a jam): with the
 // clips' swing speed given, the foot is carried at no more than that speed; without it, the
 // release's shortest time (twice the halflife) would carry it at several times that.
