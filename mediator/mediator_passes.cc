@@ -205,8 +205,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
         const float away = dist > 1e-6f ? glm::dot(step, from_foot) / dist : 0.0f;
         const float gap = std::max(0.0f, sr.radius - dist);
         float allowed;
-        if (sr.landing_s > 0.0f) {
-          allowed = gap * std::min(1.0f, dt / sr.landing_s);
+        if (sr.landing_s >= 0.0f) {
+          allowed = sr.landing_s > dt ? gap * dt / sr.landing_s : gap;
         } else {
           // The speed from which braking frame by frame covers the gap: v dt + (v - a dt) dt +
           // ... = v^2 / 2a + v dt / 2.

@@ -881,16 +881,16 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       goal_ankle = toe_goal + r * d;
       ankle_world_rot[side] = r * ankle_world_rot[side];
     }
-    if (!letting_go && locks_.lock[k].state == FootLockState::kLocked &&
+    if (P.support_hold && !letting_go && locks_.lock[k].state == FootLockState::kLocked &&
         locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state != FootLockState::kLocked) {
       // This foot carries the body alone: the hip can go no further from it than the leg reaches
-      // with the heel as high as it rises (the mediator holds the root within that next frame,
-      // MediatorParams::support_hold).
+      // with the heel as high as it rises and the pelvis as low as it drops (the mediator holds
+      // the root within that next frame, MediatorParams::support_hold).
       glm::vec3 far_ankle = goal_ankle;
       if (glm::length(pitch_axis) > 0.5f) {
         far_ankle = toe_goal + glm::angleAxis(heel_pivot::heel_room(d), pitch_axis) * d;
       }
-      const float dy = hip_p.y - far_ankle.y;
+      const float dy = hip_p.y - (kMaxDrop - drop_[slot]) - far_ankle.y;
       const float r = limit > dy ? std::sqrt(limit * limit - dy * dy) : 0.0f;
       SupportReach& sr = support_reach_[slot];
       sr.centre = glm::vec2(far_ankle.x - (hip_p.x - placed[3].x),

@@ -140,7 +140,9 @@ TEST(Quality, JammedBodiesAreHeldByTheirSupportFoot) {
   auto a = scenario_crowd("bottleneck", true);
   auto b = scenario_crowd("bottleneck", true);
   auto c = scenario_crowd("bottleneck", true);
-  const MetricsReport apm = run_source(*a, *lib, MediatorMode::kApm);
+  MediatorParams hold;
+  hold.support_hold = true;
+  const MetricsReport apm = run_source(*a, *lib, MediatorMode::kApm, hold);
   expect_body_bounds(apm, false, "bottleneck detour mannequin");
   expect_feet_never_below_the_floor(apm, run_source(*b, *lib, MediatorMode::kNaive),
                                     "bottleneck detour mannequin");
@@ -148,9 +150,7 @@ TEST(Quality, JammedBodiesAreHeldByTheirSupportFoot) {
   EXPECT_LE(apm.feet.support_skate_ratio, 0.005);
   EXPECT_LE(apm.feet.limb_pop_rate, 1.0);
   EXPECT_EQ(apm.pop_count, 0);
-  MediatorParams no_hold;
-  no_hold.support_hold = false;
-  const MetricsReport unheld = run_source(*c, *lib, MediatorMode::kApm, no_hold);
+  const MetricsReport unheld = run_source(*c, *lib, MediatorMode::kApm);
   EXPECT_GT(unheld.feet.support_skate_ratio, 1.25 * apm.feet.support_skate_ratio);
   EXPECT_GT(unheld.feet.float_ratio, 1.4 * apm.feet.float_ratio);
 }

@@ -12,6 +12,7 @@
 
 #include "mediator/mediator_passes.h"
 #include "tests/mediator/mediator_fixture.h"
+#include "tests/mediator/scripted_crowd.h"
 
 namespace gk {
 namespace {
@@ -21,7 +22,11 @@ constexpr float kDt = 1.0f / 60.0f;
 // One agent in slot 0, walking along +z, its support foot's reach a circle about `centre`.
 struct OneAgent {
   const LocomotionLibrary& lib = test::builtin_library();
-  MediatorParams params;
+  MediatorParams params = [] {
+    MediatorParams p;
+    p.support_hold = true;  // off by default
+    return p;
+  }();
   std::vector<int32_t> slot_of_agent{0};
   std::vector<uint8_t> fresh{0};
   std::vector<glm::vec2> positions{glm::vec2(0.0f, 1.0f)};
@@ -52,17 +57,22 @@ glm::vec2 unheld_root(const OneAgent& a) {
 
 TEST(SupportHold, TheRootSlowsWithinTheReachAndKeepsItsDirection) {
   OneAgent a;
-  a.reach[0].radius = 0.55f;  // 7 cm left: about what braking at kSupportBrake from 1.2 m/s takes
+  a.reach[0].radius = 0.53f;  // 5 cm left: less than braking at kSupportBrake from 1.2 m/s takes
+  a.vel[0] = glm::vec2(0.6f, 1.04f);  // 1.2 m/s, 30 deg off the line from the foot
+  a.positions[0] = glm::vec2(0.01f, 1.0f);
   const glm::vec2 prev = a.root_xz[0];
   const glm::vec2 free_root = unheld_root(a);
   const glm::vec2 centre = a.reach[0].centre;
   // Free, the root would come closer to the edge than it can still stop in.
   ASSERT_GT(glm::length(free_root - centre), 0.49f);
+  const float speed_before = a.root_speed[0];
   const glm::vec2 root = a.root_step(/*honoured=*/true);
   EXPECT_LE(glm::length(root - centre), a.reach[0].radius);
   const glm::vec2 step = root - prev, free_step = free_root - prev;
   EXPECT_GT(glm::dot(step, glm::normalize(free_step)), 0.0f);  // slowed, not stopped
   EXPECT_LT(glm::length(step), glm::length(free_step));
+  // Braked no harder than kSupportBrake from last frame's speed.
+  EXPECT_GE(glm::length(step) / kDt, speed_before - kSupportBrake * kDt - 1e-3f);
   // The same direction: the lower body's travel (and the heading metric) does not swing.
   EXPECT_NEAR(step.x * free_step.y - step.y * free_step.x, 0.0f, 1e-7f);
   // The hold is what the root was held back by, and the simulator is given it.
@@ -203,6 +213,49 @@ TEST(SupportHold, ARootBeyondTheReachNeverMovesBackwardNorStopsDead) {
     EXPECT_NEAR(glm::length(root - prev) / kDt, 1.2f - kSupportBrake * kDt, 1e-3f);
     EXPECT_LT(glm::length(root - prev), glm::length(free_root - prev));
   }
+}
+
+// Through the pipeline: pose synthesis publishes a reach exactly for the agents with one foot
+// pinned and the other not, about the pinned foot, no larger than the leg; the landing of the
+// other foot is expected within a stride.
+TEST(SupportHold, PoseSynthesisPublishesTheReachOfASingleSupportFoot) {
+  const LocomotionLibrary& lib = test::builtin_library();
+  std::vector<test::Script> scripts;
+  for (int i = 0; i < 4; ++i) {
+    scripts.push_back(test::straight(glm::vec2(2.0f * i, 0.0f), glm::vec2(0.3f, 1.1f + 0.2f * i)));
+  }
+  test::ScriptedCrowd crowd(scripts, /*honour_feedback=*/true);
+  MediatorParams params;
+  params.support_hold = true;
+  CrowdPipeline pipeline(lib, params, test::test_pipeline_options(crowd.capacity(), kDt));
+  int published = 0, single = 0, late = 0;
+  const float leg = std::max(lib.leg_length_m[0], lib.leg_length_m[1]);
+  for (int f = 0; f < 240; ++f) {
+    ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+    const AnimationPlans& pl = pipeline.mediator().plans();
+    const std::span<const SupportReach> reach = pipeline.poses().support_reach();
+    const FootLocks& locks = pipeline.poses().foot_locks();
+    for (size_t i = 0; i < crowd.capacity(); ++i) {
+      const int slot = pl.slot_of_agent[i];
+      const bool l = locks.lock[slot * 2].state == FootLockState::kLocked;
+      const bool r = locks.lock[slot * 2 + 1].state == FootLockState::kLocked;
+      if (f > 0 && l != r) ++single;
+      const SupportReach& sr = reach[slot];
+      if (sr.radius < 0.0f) continue;
+      ++published;
+      EXPECT_NE(l, r) << "frame " << f << " agent " << i;
+      EXPECT_LE(sr.radius, leg) << f;
+      // The circle is about the pinned foot, placed for the root: its centre is where the root
+      // stands over that foot, within a leg's length of the root.
+      EXPECT_LT(glm::length(sr.centre - pl.root_xz[slot]), leg) << f;
+      if (sr.landing_s >= 1.0f) ++late;  // a walk's swing lasts about 0.4 s
+    }
+  }
+  EXPECT_GT(published, 100);
+  // From the other foot's swing progress over the last frame: as good as that rate (a swing that
+  // slows, as a start's first step does, is expected to land late).
+  EXPECT_LT(late, published / 50);
+  EXPECT_GT(published, single / 2);
 }
 
 }  // namespace
