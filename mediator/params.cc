@@ -51,7 +51,8 @@ constexpr ParamInfo kInfos[] = {
     {"idle_step_time_s", "s", "duration of a re-planting step while standing or turning", 0.1f,
      1.0f, K::kFloat, &P::idle_step_time_s},
     {"support_hold", "on/off",
-     "hold the body within reach of a foot that carries it alone (the held position is fed back)",
+     "hold the body within reach of a foot that carries it alone, fed back to the simulator "
+     "(needs feedback; slows walking too)",
      0.0f, 1.0f, K::kBool, nullptr, &P::support_hold},
     {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator",
      0.0f, 1.0f, K::kBool, nullptr, &P::feedback},

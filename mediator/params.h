@@ -40,8 +40,10 @@ struct MediatorParams {
   float idle_step_distance_m =
       0.12f;                       // [m] [Limit: 0.02..0.5] planted-foot drift that triggers a step
   float idle_step_time_s = 0.35f;  // [s] [Limit: 0.1..1] duration of a re-planting step
-  // The root never leaves the reach of a foot that carries the body alone (the other in the
-  // air): it slows as that leg straightens, and the simulator is given the held position.
+  // The root is held within the reach of a foot that carries the body alone (the other in the
+  // air): it slows as that leg straightens, braking no harder than about g (beyond, the foot
+  // gives); with `feedback` on and a source that takes it, the simulator is given the held
+  // position and speed (no hold otherwise).
   // Off by default: its estimate of the reach is cautious, and ordinary walking is slowed too
   // (the mannequin's corridor crowd by 13%; README).
   bool support_hold = false;

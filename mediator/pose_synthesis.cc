@@ -928,6 +928,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
         // drawn already: the clip's toe now is the one of the frame it was last drawn.
         locks_.lock[k] = release_foot_lock(locks_.lock[k], drawn, glm::vec3(0.0f), anim_toe[side],
                                            anim_vel[side]);
+        support_reach_[slot] = SupportReach{};  // let go: it no longer holds the body
       }
     }
     const glm::vec3 knee_p = translation_of(world[knee]);

@@ -1,8 +1,9 @@
 // A foot that carries the body alone holds it back (issue #9: in a Detour jam the simulator's
 // velocity lurches faster than legs can follow, and the support foot was dragged along or let go
 // while the other was in the air). The root pass brakes the root as the support leg straightens
-// (no harder than kSupportBrake), never lets it leave the leg's reach, keeps its direction, and
-// the feedback gives the simulator the held position and the speed kept.
+// (no harder than kSupportBrake: a root that cannot stop in time leaves the reach, and the foot
+// gives), keeps its direction, and the feedback gives the simulator the held position and the
+// speed kept.
 
 #include <cmath>
 #include <vector>
@@ -172,7 +173,7 @@ TEST(SupportHold, TheRootMayUseTheReachUntilTheOtherFootLands) {
     a.root_speed[0] = 0.6f;
     a.positions[0] = glm::vec2(0.0f, 0.99f);
     a.reach[0].radius = 0.52f;     // 4 cm left
-    a.reach[0].landing_s = 0.1f;   // 6 frames: 6 cm at 0.6 m/s
+    a.reach[0].landing_s = 0.1f + 1e-3f;  // 6 frames: 6 cm at 0.6 m/s
     const glm::vec2 centre = a.reach[0].centre;
     float speed[6];
     for (int f = 0; f < 6; ++f) {
@@ -255,6 +256,14 @@ TEST(SupportHold, PoseSynthesisPublishesTheReachOfASingleSupportFoot) {
   // From the other foot's swing progress over the last frame: as good as that rate (a swing that
   // slows, as a start's first step does, is expected to land late).
   EXPECT_LT(late, published / 50);
+
+  // Off (the default), nothing is published, and the crowd is not held.
+  test::ScriptedCrowd plain(scripts, /*honour_feedback=*/true);
+  CrowdPipeline off(lib, MediatorParams{}, test::test_pipeline_options(plain.capacity(), kDt));
+  for (int f = 0; f < 120; ++f) {
+    ASSERT_TRUE(off.step(plain, kDt).ok());
+    for (const SupportReach& sr : off.poses().support_reach()) EXPECT_LT(sr.radius, 0.0f);
+  }
   EXPECT_GT(published, single / 2);
 }
 
