@@ -211,7 +211,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
           // The speed from which braking frame by frame covers the gap: v dt + (v - a dt) dt +
           // ... = v^2 / 2a + v dt / 2.
           const float half = 0.5f * kSupportBrake * dt;
-          allowed = std::min(gap, (std::sqrt(half * half + 2.0f * kSupportBrake * gap) - half) * dt);
+          allowed =
+              std::min(gap, (std::sqrt(half * half + 2.0f * kSupportBrake * gap) - half) * dt);
         }
         if (away > allowed) {
           // No harder a brake than kSupportBrake from the root's own speed last frame.
@@ -220,10 +221,7 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
           const float scale = std::clamp(
               std::max(allowed / away, speed > 1e-4f ? floor_speed / speed : 0.0f), 0.0f, 1.0f);
           out_hold_scale[slot] = scale;
-          glm::vec2 held = prev + step * scale;
-          const glm::vec2 off = held - p;
-          const float off_len = glm::length(off);
-          if (off_len > kMaxRootOffset) held = p + off * (kMaxRootOffset / off_len);
+          const glm::vec2 held = near_p(prev + step * scale, p);
           out_hold[slot] = held - root;
           root = held;
         }
@@ -233,9 +231,10 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
     } else {
       root_xz[slot] = p;
     }
-    root_speed[slot] = glm::length(root_vel);
+    const float speed = glm::length(root_vel);
+    root_speed[slot] = speed;
     out_root_heading[slot] =
-        standing[slot] ? lower_yaw[slot] : heading2(glm::length(root_vel) > 1e-3f ? root_vel : vel);
+        standing[slot] ? lower_yaw[slot] : heading2(speed > 1e-3f ? root_vel : vel);
   });
 }
 

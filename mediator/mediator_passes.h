@@ -69,18 +69,20 @@ inline bool sane_input(const glm::vec2& p, const glm::vec2& v, float theta) {
   return finite2(v) && !(glm::length(v) > kAbsurdSpeed) && usable_position(p) &&
          std::isfinite(theta);
 }
-// The drawn root one step of dt [s] on: predicted from `root` with the filtered velocity and
-// pulled onto the simulator's p, never more than kMaxRootOffset from it.
 // The pull of pulled_root over a step dt [s] (one exp, shared by every agent stepped by dt).
 inline float root_pull(float dt) { return 1.0f - std::exp(-dt / kRootPullTime); }
+// A drawn root no further than kMaxRootOffset from the simulator's p.
+inline glm::vec2 near_p(const glm::vec2& root, const glm::vec2& p) {
+  const glm::vec2 off = root - p;
+  const float len = glm::length(off);
+  return len > kMaxRootOffset ? p + off * (kMaxRootOffset / len) : root;
+}
+// The drawn root one step of dt [s] on: predicted from `root` with the filtered velocity and
+// pulled onto the simulator's p, never more than kMaxRootOffset from it.
 inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const glm::vec2& p,
                              float dt, float pull) {
   const glm::vec2 predicted = root + vel * dt;
-  glm::vec2 out = predicted + (p - predicted) * pull;
-  const glm::vec2 off = out - p;
-  const float len = glm::length(off);
-  if (len > kMaxRootOffset) out = p + off * (kMaxRootOffset / len);
-  return out;
+  return near_p(predicted + (p - predicted) * pull, p);
 }
 
 // A layer's clip time: a gait clip's at the shared gait phase, a standing clip's on its clock, a

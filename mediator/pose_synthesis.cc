@@ -893,8 +893,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       const float dy = hip_p.y - (kMaxDrop - drop_[slot]) - far_ankle.y;
       const float r = limit > dy ? std::sqrt(limit * limit - dy * dy) : 0.0f;
       SupportReach& sr = support_reach_[slot];
-      sr.centre = glm::vec2(far_ankle.x - (hip_p.x - placed[3].x),
-                            far_ankle.z - (hip_p.z - placed[3].z));
+      sr.centre =
+          glm::vec2(far_ankle.x - (hip_p.x - placed[3].x), far_ankle.z - (hip_p.z - placed[3].z));
       sr.radius = r;
       // When the other foot comes down: a re-planting step when its time is up; a foot in the
       // clips' swing when its progress, at its rate over the last frame, reaches 1.

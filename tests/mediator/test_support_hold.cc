@@ -8,8 +8,8 @@
 #include <cmath>
 #include <vector>
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include "mediator/mediator_passes.h"
 #include "tests/mediator/mediator_fixture.h"
@@ -114,9 +114,9 @@ TEST(SupportHold, APushedBodyComesToRestAtTheEdgeOfTheReach) {
       last_speed = speed;
       ++held;
     }
-    a.positions[0] += a.hold[0];                 // the simulator takes the held position
+    a.positions[0] += a.hold[0];  // the simulator takes the held position
     EXPECT_LE(glm::length(root - a.positions[0]), kMaxRootOffset + 1e-6f) << f;
-    a.positions[0] += a.vel[0] * kDt;            // and pushes on
+    a.positions[0] += a.vel[0] * kDt;  // and pushes on
   }
   EXPECT_LT(a.reach[0].radius - glm::length(a.root_xz[0] - centre), 1e-3f);
   EXPECT_GT(held, 20);
@@ -172,7 +172,7 @@ TEST(SupportHold, TheRootMayUseTheReachUntilTheOtherFootLands) {
     a.vel[0] = glm::vec2(0.0f, 0.6f);
     a.root_speed[0] = 0.6f;
     a.positions[0] = glm::vec2(0.0f, 0.99f);
-    a.reach[0].radius = 0.52f;     // 4 cm left
+    a.reach[0].radius = 0.52f;            // 4 cm left
     a.reach[0].landing_s = 0.1f + 1e-3f;  // 6 frames: 6 cm at 0.6 m/s
     const glm::vec2 centre = a.reach[0].centre;
     float speed[6];
