@@ -659,6 +659,12 @@ float LocomotionClip::time_at_phase(float phase) const {
   return phase_to_time[i] + u * (phase_to_time[i + 1] - phase_to_time[i]);
 }
 
+float LocomotionClip::time_per_phase(float phase) const {
+  const float x = std::clamp(phase - std::floor(phase), 0.0f, 1.0f) * kPhaseTableSize;
+  const int i = std::min(static_cast<int>(x), kPhaseTableSize - 1);
+  return (phase_to_time[i + 1] - phase_to_time[i]) * kPhaseTableSize;
+}
+
 std::vector<std::string> describe_takes(const LocomotionLibrary& library) {
   std::vector<std::string> out;
   for (const TakeReport& t : library.takes) {

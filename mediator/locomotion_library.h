@@ -67,6 +67,9 @@ struct LocomotionClip {
   // taken out frame by frame (not at one mean speed), so the pose keeps only the pelvis's sway.
   bool transition = false;
   float time_at_phase(float phase) const;  // phase in [0, 1)
+  // Clip seconds per unit of phase there (the table's local slope: the cycle's own steps may run
+  // faster or slower than its mean, cycle_s).
+  float time_per_phase(float phase) const;
   // Frame index i of the clip wrapped (a loop) or clamped into range; one already in range is
   // its own (no division: the per-frame contacts pass calls it per layer).
   int wrap_frame(int i) const {

@@ -713,9 +713,13 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     // a standing clip's "both feet down" would otherwise keep a stepping foot locked while it
     // swings.
     float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
-    float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, walk = 0.0f;
+    float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, swing_rate[2] = {0.0f, 0.0f};
+    float walk = 0.0f;
     float toe_speed[2] = {0.0f, 0.0f}, speed_w[2] = {0.0f, 0.0f};
     const float rate = playback_rate[slot], tr_rate = transition_rate[slot];
+    // Gait phase per second (rate_phase_pass's), taken once a clip swings a foot: a gait clip's
+    // time runs at its table's local slope times that.
+    float phase_rate = -1.0f;
     float moving_w = gait_w;  // gait clips and a transition: they vote without the standing clip
     for (int k = 0; k < kMaxBlendLayers; ++k) {
       if (lib.clips[lc[k]].transition) moving_w += lw[k];
@@ -747,6 +751,8 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
         }
       }
       if (gait_votes && !clip.gait && !clip.transition) continue;
+      // A gait clip runs at the playback rate, a transition at its own clock's.
+      const float r = clip.transition ? tr_rate : clip.gait ? rate : 1.0f;
       vote_w += lw[k];
       if (clip.double_support) walk += lw[k];
       for (int s = 0; s < 2; ++s) {
@@ -757,11 +763,17 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
           const auto& sp = clip.swing_progress[s];
           const float a = sp[wrap(f0)], b = sp[wrap(f0 + 1)];
           swing[s] += lw[k] * (b >= a ? a + fu * (b - a) : sp[f]);
+          if (b > a) {
+            float clip_rate = r;  // clip seconds per second
+            if (clip.gait) {
+              if (phase_rate < 0.0f) phase_rate = gait_frequency(lib, lc, lw).cycles_per_s * rate;
+              clip_rate = clip.time_per_phase(phase[slot]) * phase_rate;
+            }
+            swing_rate[s] += lw[k] * (b - a) * clip.clip.fps * clip_rate;
+          }
         }
         hold[s] += lw[k] * clip.hold[s][f];
         if (!clip.toe_speed_m_s[s].empty()) {
-          // A gait clip runs at the playback rate, a transition at its own clock's.
-          const float r = clip.transition ? tr_rate : clip.gait ? rate : 1.0f;
           toe_speed[s] += lw[k] * clip.toe_speed_m_s[s][f] * r;
           speed_w[s] += lw[k];
         }
@@ -771,6 +783,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       out.plant[s][slot] = plant[s] / std::max(vote_w, 1e-6f);
       out.hold[s][slot] = hold[s] / std::max(vote_w, 1e-6f);
       out.swing_progress[s][slot] = swing[s] / std::max(vote_w, 1e-6f);
+      out.swing_rate[s][slot] = swing_rate[s] / std::max(vote_w, 1e-6f);
       out.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : 0.0f;
       out.clip_toe_speed[s][slot] = speed_w[s] > 0.0f ? toe_speed[s] / speed_w[s] : -1.0f;
     }

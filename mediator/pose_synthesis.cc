@@ -38,6 +38,16 @@ glm::mat4 root_placement(const glm::vec2& xz, float yaw) {
   return m;
 }
 
+// How far a foot must move over the floor along u (unit, horizontal) for a leg of `reach` to
+// reach its ankle, at p from the hip: the smaller root of |p + t u| = reach; 0 when it reaches
+// already, and the closest approach when no move does.
+float move_to_reach(const glm::vec3& p, const glm::vec3& u, float reach) {
+  const float pp = glm::dot(p, p);
+  if (pp <= reach * reach) return 0.0f;
+  const float pu = glm::dot(p, u);
+  return std::max(0.0f, -pu - std::sqrt(std::max(0.0f, pu * pu - pp + reach * reach)));
+}
+
 glm::quat rotation_of(const glm::mat4& m) { return glm::normalize(glm::quat_cast(glm::mat3(m))); }
 
 // The pelvis is lowered so pinned feet stay within kDropReach of the leg length, by at most
@@ -785,6 +795,45 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     swing_prev_[k] = pl.swing_progress[side][slot];
     const FootLockState st = locks_.lock[k].state;
     pinned[side] = st == FootLockState::kLocked || st == FootLockState::kStepping;
+  }
+  // A new agent's weight-bearing foot is placed as a walker's would be at this phase: it has been
+  // pinned since it landed, the body has come over it, and the leg still reaches it when the
+  // other foot comes down. The clips' own toe may be elsewhere: a blend of clips with different
+  // stance lengths (a walk's push-off and a jog's early swing at the same phase) holds it above
+  // the floor and further back than the legs reach, and pinned there it was let go at once and
+  // floated until the other foot landed.
+  if (pl.fresh[slot] && !letting_go) {
+    for (int side = 0; side < 2; ++side) {
+      FootLock& lock = locks_.lock[static_cast<size_t>(slot) * 2 + side];
+      if (lock.state != FootLockState::kLocked) continue;
+      const Side sd = static_cast<Side>(side);
+      const bool alone = !pinned[1 - side];
+      glm::vec3 g = goal[side];
+      if (alone) g.y = library_.planted_toe_m[side];  // it carries the body: on the floor
+      const glm::vec3 hip_p = translation_of(world[skeleton_.hip(sd)]);
+      const float toward = ground_length(hip_p.x - g.x, hip_p.z - g.z);
+      if (toward > 1e-4f) {
+        // Moved toward the hip over the floor as far as the leg needs to reach it now, and from
+        // where the hip will be when the other foot lands (the other foot's swing at its rate,
+        // the body at its speed in its direction of travel); never past the hip.
+        const glm::vec3 u((hip_p.x - g.x) / toward, 0.0f, (hip_p.z - g.z) / toward);
+        const glm::vec3 ankle = translation_of(world[skeleton_.ankle(sd)]) + g -
+                                translation_of(world[skeleton_.toe(sd)]);
+        const float reach = kIkSoften * kIkMaxExtension * library_.leg_length_m[side];
+        float t = move_to_reach(ankle - hip_p, u, reach);
+        const float rate = pl.swing_rate[1 - side][slot];
+        const float progress = pl.swing_progress[1 - side][slot];
+        if (alone && rate > 0.0f && progress < 1.0f) {
+          const float ahead = pl.speed_m_s[slot] * (1.0f - progress) / rate;
+          const float yaw = pl.travel_yaw[slot];
+          const glm::vec3 hip_then = hip_p + ahead * glm::vec3(std::sin(yaw), 0.0f, std::cos(yaw));
+          t = std::max(t, move_to_reach(ankle - hip_then, u, reach));
+        }
+        g += std::min(t, toward) * u;
+      }
+      goal[side] = lock.target = lock.last_goal = g;
+      lock.offset = lock.offset_vel = glm::vec3(0.0f);
+    }
   }
   // Pelvis drop: a pinned foot the leg cannot reach pulls the whole body down (up to kMaxDrop)
   // rather than sliding; the body moves on a critically damped spring.

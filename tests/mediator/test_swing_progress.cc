@@ -45,5 +45,44 @@ TEST(SwingProgress, AdvancesEveryFrameWithA30FpsClip) {
   EXPECT_EQ(stalled, 0) << "of " << swinging << " mid-swing frames";
 }
 
+// The rate the plans give for each swing (what pose synthesis takes for when a foot in the air
+// lands) is the advance the progress itself makes from one frame to the next, walking steadily.
+TEST(SwingProgress, RateIsTheProgressAdvancePerSecond) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
+  auto lib = test::load_data_library({"clips/bvh/more/cmu_16_15_walk_mrl30.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  constexpr float kDt = 1.0f / 60.0f;
+  const float speed = lib->clips[lib->groups[lib->forward_group].clips.front()].speed_m_s;
+  Mediator m(*lib, MediatorParams{}, 1);
+  const uint32_t id = 1;
+  glm::vec2 pos(0.0f), vel(0.0f, speed);
+  const float theta = 0.0f;
+  float prev[2] = {-1.0f, -1.0f}, prev_rate[2] = {0.0f, 0.0f};
+  int compared = 0, grounded = 0;
+  for (int f = 0; f < 240; ++f) {
+    pos += vel * kDt;
+    ASSERT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt).ok());
+    const AnimationPlans& pl = m.plans();
+    const int slot = pl.slot_of_agent[0];
+    for (int s = 0; s < 2; ++s) {
+      const float p = pl.swing_progress[s][slot], rate = pl.swing_rate[s][slot];
+      if (f >= 60 && p > 0.05f && p < 0.95f && prev[s] > 0.05f && prev[s] < 0.95f) {
+        // The advance over the last frame, against the mean of the rates at its two ends.
+        const float advance = (p - prev[s]) / kDt;
+        EXPECT_NEAR(advance, 0.5f * (rate + prev_rate[s]), 0.01f * advance) << f;
+        ++compared;
+      }
+      if (f >= 60 && p == 0.0f) {
+        EXPECT_EQ(rate, 0.0f) << f;  // on the ground
+        ++grounded;
+      }
+      prev[s] = p;
+      prev_rate[s] = rate;
+    }
+  }
+  EXPECT_GT(compared, 40);
+  EXPECT_GT(grounded, 40);
+}
+
 }  // namespace
 }  // namespace gk
