@@ -63,13 +63,16 @@ void CrowdRecorder::record(const CrowdSession& session, int64_t selected_id) {
       a.playback_rate = s >= 0 ? plans.playback_rate[s] : 0.0f;
       a.posed = s >= 0 && (i < limit || i == selected_index) && posed < posed_cap_;
       if (!a.posed) continue;
-      const auto palette = lane.poses().palette(s);
+      // The skinning palette from the pose (world * inverse bind): the lane's own are made for the
+      // upload (CrowdPipeline::update_palettes), after this.
+      const auto world = lane.poses().world(s);
+      const auto& inverse_bind = lane.poses().inverse_bind();
       // Kept as drawn: a held pose (level of detail) moved on by its root offset.
       const glm::vec2 offset = lane.poses().root_offset(s);
       const glm::vec3 moved(offset.x, 0.0f, offset.y);
       glm::vec4* rows = &rows_[(slot * posed_cap_ + posed) * J * 3];
-      for (size_t j = 0; j < J && j < palette.size(); ++j) {
-        const glm::mat4& m = palette[j];
+      for (size_t j = 0; j < J && j < world.size() && j < inverse_bind.size(); ++j) {
+        const glm::mat4 m = world[j] * inverse_bind[j];
         // Affine: the bottom row is (0, 0, 0, 1); the top three rows are kept.
         for (int r = 0; r < 3; ++r) {
           rows[j * 3 + r] = glm::vec4(m[0][r], m[1][r], m[2][r], m[3][r] + moved[r]);

@@ -110,6 +110,7 @@ Result<std::unique_ptr<SceneView>> SceneView::create(const CrowdSession& session
 }
 
 Status SceneView::upload(const CrowdSession& session, const AnimationLane& lane) {
+  if (lane.pipeline) lane.pipeline->update_palettes();  // a recorded lane has its own
   return renderer_->upload_palettes(lane.palette_span(session.joints()), session.joints());
 }
 

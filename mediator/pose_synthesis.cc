@@ -117,7 +117,10 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   }
   local_rot_.assign(capacity * J, glm::quat(1, 0, 0, 0));
   world_.assign(capacity * J, glm::mat4(1.0f));
-  if (make_palettes_) palette_.assign(capacity * J, glm::mat4(1.0f));
+  if (make_palettes_) {
+    palette_.assign(capacity * J, glm::mat4(1.0f));
+    palette_due_.assign(capacity, 0);
+  }
   rot_change_.assign(capacity, 0.0f);
   torsion_.assign(capacity, 0.0f);
   pelvis_heading_.assign(capacity, 0.0f);
@@ -342,10 +345,10 @@ void PoseSynthesizer::run(const AnimationPlans& pl, size_t n, const MediatorPara
         synthesize_agent(pl, P, slot, dt_s, s, d == PoseDetail::kHold ? PoseDetail::kLight : d);
       }
     }
-    // The range's streamed palettes and world joints are ordered before the task's end tells
-    // anyone they are done (one fence here, not one per agent: each waits for the stores before
-    // it to reach memory).
-    if (stream_palettes_ || stream_world_) stream_fence();
+    // The range's streamed world joints are ordered before the task's end tells anyone they are
+    // done (one fence here, not one per agent: each waits for the stores before it to reach
+    // memory).
+    if (stream_world_) stream_fence();
   });
 }
 
@@ -648,20 +651,33 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
   }
   prev_rot_valid_[slot] = track_rotation;
   has_prev_[slot] = 1;
-  if (make_palettes_) {
-    SkinningPaletteJob job;
-    job.model = {world, J};
-    job.inverse_bind = inverse_bind_;
-    job.out_palette = {palette_.data() + base, J};
-    job.affine_inverse_bind = affine_inverse_bind_;
-    job.translation_inverse_bind = translation_inverse_bind_;
-    job.stream_out = stream_palettes_;
-    job.fence = false;  // run() fences once per range of agents
-    if (stream_world_) job.out_model_copy = {world_.data() + base, J};
-    job.run();
-  } else if (stream_world_) {
-    copy_matrices({world, J}, {world_.data() + base, J}, /*stream=*/true);
-  }
+  if (stream_world_) copy_matrices({world, J}, {world_.data() + base, J}, /*stream=*/true);
+  if (make_palettes_) palette_due_[slot] = 1;
+}
+
+void PoseSynthesizer::update_palettes() {
+  if (!make_palettes_) return;
+  const size_t J = static_cast<size_t>(num_joints_);
+  auto make = [&](const tbb::blocked_range<size_t>& r) {
+    bool streamed = false;
+    for (size_t slot = r.begin(); slot < r.end(); ++slot) {
+      if (!palette_due_[slot]) continue;
+      palette_due_[slot] = 0;
+      SkinningPaletteJob job;
+      job.model = {world_.data() + slot * J, J};
+      job.inverse_bind = inverse_bind_;
+      job.out_palette = {palette_.data() + slot * J, J};
+      job.affine_inverse_bind = affine_inverse_bind_;
+      job.translation_inverse_bind = translation_inverse_bind_;
+      job.stream_out = stream_palettes_;
+      job.fence = false;  // once per range, below
+      job.run();
+      streamed = streamed || stream_palettes_;
+    }
+    // The range's streamed palettes are ordered before the task's end tells anyone they are done.
+    if (streamed) stream_fence();
+  };
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, palette_due_.size(), 64), make);
 }
 
 // A far agent's pose (PoseDetail::kLight) on the coarse joints only (mediator/coarse_pose.h): the

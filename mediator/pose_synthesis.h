@@ -80,8 +80,12 @@ class PoseSynthesizer {
     const glm::vec2 o = root_offset_[slot];
     return {t.x + o.x, t.y, t.z + o.y};
   }
-  // Every slot's skinning palette, slot after slot (empty without make_palettes); drawn with
-  // root_offset added to their translations, like world().
+  // Makes the skinning palettes (world * inverse bind) of the slots posed since the last call:
+  // the renderer's work (METRICS.md counts it in `upload`), done only where palettes are drawn or
+  // read, not in run(). Nothing without make_palettes.
+  void update_palettes();
+  // Every slot's skinning palette as of the last update_palettes(), slot after slot (empty without
+  // make_palettes); drawn with root_offset added to their translations, like world().
   std::span<const glm::mat4> palettes() const { return palette_; }
   std::span<const glm::mat4> palette(int slot) const {
     return {palette_.data() + static_cast<size_t>(slot) * num_joints_,
@@ -153,6 +157,7 @@ class PoseSynthesizer {
   std::vector<glm::quat> local_rot_;  // the last posed rotations (max_rotation_change's reference)
   std::vector<glm::mat4> world_;
   std::vector<glm::mat4> palette_;
+  std::vector<uint8_t> palette_due_;  // per slot: posed since its palette was last made
   std::vector<float> rot_change_;
   std::vector<float> torsion_;
   std::vector<float> pelvis_heading_;

@@ -109,6 +109,7 @@ TEST(Garbage, NothingFromTheSimulatorReachesPalettesPlansOrFeedback) {
   int bad_palette = 0, bad_plan = 0, bad_feedback = 0;
   for (int f = 0; f < 300; ++f) {
     ASSERT_TRUE(pipeline.step(crowd, kDt).ok()) << "frame " << f;
+    pipeline.update_palettes();
     const AgentFrame frame = pipeline.frame();
     const AnimationPlans& pl = mediator.plans();
     for (size_t i = 0; i < frame.size(); ++i) {

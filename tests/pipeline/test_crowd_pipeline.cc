@@ -55,6 +55,7 @@ TEST(CrowdPipeline, FailedFrameLeavesTheLastGoodFrameDrawable) {
   RepeatingIdCrowd crowd(walkers(4, 1.3f));
   CrowdPipeline pipeline(lib, MediatorParams{}, drawn(crowd.capacity()));
   for (int f = 0; f < 40; ++f) ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+  pipeline.update_palettes();
   const AgentFrame frame = pipeline.frame();
   const std::vector<uint32_t> ids(frame.ids.begin(), frame.ids.end());
   const std::vector<glm::vec2> positions(frame.positions.begin(), frame.positions.end());
@@ -77,7 +78,8 @@ TEST(CrowdPipeline, FailedFrameLeavesTheLastGoodFrameDrawable) {
   EXPECT_EQ(pipeline.num_slots(), slots);
   EXPECT_EQ(pipeline.frames_run(), frames);
   // Drawable: every agent of the frame has a finite palette in a slot below num_slots(), the
-  // very matrices of the last good frame.
+  // very matrices of the last good frame (the failed frame posed nothing to make them again from).
+  pipeline.update_palettes();
   const auto now = pipeline.palettes();
   ASSERT_EQ(now.size(), palettes.size());
   EXPECT_TRUE(std::equal(now.begin(), now.end(), palettes.begin()));
@@ -150,6 +152,7 @@ TEST(CrowdPipeline, PalettesInSlotOrder) {
   test::ScriptedCrowd crowd(walkers(5, 1.2f));
   CrowdPipeline pipeline(lib, MediatorParams{}, drawn(5));
   for (int f = 0; f < 10; ++f) ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+  pipeline.update_palettes();
   const size_t J = static_cast<size_t>(pipeline.num_joints());
   ASSERT_EQ(pipeline.num_slots(), 5u);
   ASSERT_EQ(pipeline.palettes().size(), 5 * J);
@@ -158,6 +161,37 @@ TEST(CrowdPipeline, PalettesInSlotOrder) {
     const auto own = pipeline.poses().palette(slot);
     EXPECT_TRUE(std::equal(own.begin(), own.end(), pipeline.palettes().begin() + slot * J));
   }
+}
+
+// A step poses the crowd; its skinning palettes (world * inverse bind) are made when they are
+// asked for (update_palettes, before an upload): a step alone leaves last frame's, and the update
+// makes every agent's from the joints it was posed with.
+TEST(CrowdPipeline, PalettesAreMadeFromThePoseWhenAskedFor) {
+  const LocomotionLibrary& lib = test::builtin_library();
+  test::ScriptedCrowd crowd(walkers(5, 1.2f));
+  CrowdPipeline pipeline(lib, MediatorParams{}, drawn(5));
+  for (int f = 0; f < 10; ++f) ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+  pipeline.update_palettes();
+  const std::vector<glm::mat4> before(pipeline.palettes().begin(), pipeline.palettes().end());
+  ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+  EXPECT_TRUE(std::equal(before.begin(), before.end(), pipeline.palettes().begin()));
+  pipeline.update_palettes();
+  const size_t J = static_cast<size_t>(pipeline.num_joints());
+  const auto& inverse_bind = pipeline.poses().inverse_bind();
+  int moved = 0;
+  for (size_t i = 0; i < 5; ++i) {
+    const int slot = pipeline.plans().slot_of_agent[i];
+    const auto world = pipeline.poses().world(slot);
+    const auto palette = pipeline.poses().palette(slot);
+    for (size_t j = 0; j < J; ++j) {
+      const glm::mat4 expected = world[j] * inverse_bind[j];
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) EXPECT_NEAR(palette[j][c][r], expected[c][r], 1e-5f);
+      }
+      moved += palette[j] != before[slot * J + j];
+    }
+  }
+  EXPECT_GT(moved, 0);  // walkers: the new palettes are not last frame's
 }
 
 // Hooks run once per good frame, after the metrics, and their errors end the step.

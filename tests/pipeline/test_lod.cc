@@ -148,6 +148,8 @@ TEST(CrowdPipelineLod, FullDetailAgentsArePosedExactlyAsWithoutLod) {
   for (int f = 0; f < 240; ++f) {
     ASSERT_TRUE(lod.step(with, kDt).ok());
     ASSERT_TRUE(full.step(without, kDt).ok());
+    lod.update_palettes();
+    full.update_palettes();
     for (size_t i = 0; i < scripts.size(); ++i) {
       const int slot = lod.plans().slot_of_agent[i];
       ASSERT_EQ(slot, full.plans().slot_of_agent[i]);
