@@ -13,24 +13,32 @@
 namespace gk {
 namespace {
 
+constexpr float kDt = 1.0f / 60.0f;
+
+// One agent walking straight at the clip's own speed for `frames` frames at 60 Hz; `each` sees the
+// frame index, the plans and the agent's slot.
+template <typename Each>
+void walk_steadily(const LocomotionLibrary& lib, int frames, Each each) {
+  const float speed = lib.clips[lib.groups[lib.forward_group].clips.front()].speed_m_s;
+  Mediator m(lib, MediatorParams{}, 1);
+  const uint32_t id = 1;
+  glm::vec2 pos(0.0f), vel(0.0f, speed);
+  const float theta = 0.0f;
+  for (int f = 0; f < frames; ++f) {
+    pos += vel * kDt;
+    ASSERT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt).ok());
+    each(f, m.plans(), m.plans().slot_of_agent[0]);
+  }
+}
+
 TEST(SwingProgress, AdvancesEveryFrameWithA30FpsClip) {
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
   auto lib = test::load_data_library({"clips/bvh/more/cmu_16_15_walk_mrl30.bvh"});
   ASSERT_TRUE(lib.ok()) << lib.message();
   ASSERT_FLOAT_EQ(lib->clips[lib->groups[lib->forward_group].clips.front()].clip.fps, 30.0f);
-  constexpr float kDt = 1.0f / 60.0f;
-  const float speed = lib->clips[lib->groups[lib->forward_group].clips.front()].speed_m_s;
-  Mediator m(*lib, MediatorParams{}, 1);
-  const uint32_t id = 1;
-  glm::vec2 pos(0.0f), vel(0.0f, speed);
-  const float theta = 0.0f;
   float prev[2] = {-1.0f, -1.0f};
   int swinging = 0, stalled = 0;
-  for (int f = 0; f < 240; ++f) {
-    pos += vel * kDt;
-    ASSERT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt).ok());
-    const AnimationPlans& pl = m.plans();
-    const int slot = pl.slot_of_agent[0];
+  walk_steadily(*lib, 240, [&](int f, const AnimationPlans& pl, int slot) {
     for (int s = 0; s < 2; ++s) {
       const float p = pl.swing_progress[s][slot];
       // Mid-swing, after the blend has settled on the walk (the first second).
@@ -40,7 +48,7 @@ TEST(SwingProgress, AdvancesEveryFrameWithA30FpsClip) {
       }
       prev[s] = p;
     }
-  }
+  });
   EXPECT_GT(swinging, 40);
   EXPECT_EQ(stalled, 0) << "of " << swinging << " mid-swing frames";
 }
@@ -51,19 +59,9 @@ TEST(SwingProgress, RateIsTheProgressAdvancePerSecond) {
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
   auto lib = test::load_data_library({"clips/bvh/more/cmu_16_15_walk_mrl30.bvh"});
   ASSERT_TRUE(lib.ok()) << lib.message();
-  constexpr float kDt = 1.0f / 60.0f;
-  const float speed = lib->clips[lib->groups[lib->forward_group].clips.front()].speed_m_s;
-  Mediator m(*lib, MediatorParams{}, 1);
-  const uint32_t id = 1;
-  glm::vec2 pos(0.0f), vel(0.0f, speed);
-  const float theta = 0.0f;
   float prev[2] = {-1.0f, -1.0f}, prev_rate[2] = {0.0f, 0.0f};
   int compared = 0, grounded = 0;
-  for (int f = 0; f < 240; ++f) {
-    pos += vel * kDt;
-    ASSERT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt).ok());
-    const AnimationPlans& pl = m.plans();
-    const int slot = pl.slot_of_agent[0];
+  walk_steadily(*lib, 240, [&](int f, const AnimationPlans& pl, int slot) {
     for (int s = 0; s < 2; ++s) {
       const float p = pl.swing_progress[s][slot], rate = pl.swing_rate[s][slot];
       if (f >= 60 && p > 0.05f && p < 0.95f && prev[s] > 0.05f && prev[s] < 0.95f) {
@@ -79,7 +77,7 @@ TEST(SwingProgress, RateIsTheProgressAdvancePerSecond) {
       prev[s] = p;
       prev_rate[s] = rate;
     }
-  }
+  });
   EXPECT_GT(compared, 40);
   EXPECT_GT(grounded, 40);
 }
