@@ -52,9 +52,11 @@ struct AnimationPlans {
   std::vector<float> clip_toe_speed[2];
   std::vector<float> gait_weight;        // share of gait clips (not standing) in the blend, 0..1
   std::vector<float> swing_progress[2];  // blended swing progress of each foot, 0..1
-  // How fast that progress runs at this frame's playback [1/s] (0 on the ground): a foot in the
-  // air lands in (1 - swing_progress) / swing_rate seconds.
-  std::vector<float> swing_rate[2];
+  // When the voting clips that have this foot in the air bring it down [s]: the mean of each one's
+  // remaining swing at its playback rate (< 0: none has it in the air). Measured in clip time at
+  // the gait phase's rate; while a start or stop transition plays, the gait layers' phase follows
+  // the transition's clock instead and their share of this is approximate.
+  std::vector<float> landing_s[2];
   std::vector<float> double_support;     // share of the voting clips that walk (0..1)
   std::vector<float> phase;              // gait phase [0, 1)
   std::vector<float> blend_progress;     // b: 0 when the chosen clips just changed, 1 when settled

@@ -47,7 +47,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
     plans_.gait_toe_y[s].assign(capacity, 0.0f);
     plans_.clip_toe_speed[s].assign(capacity, -1.0f);
     plans_.swing_progress[s].assign(capacity, 0.0f);
-    plans_.swing_rate[s].assign(capacity, 0.0f);
+    plans_.landing_s[s].assign(capacity, -1.0f);
     plans_.double_support.assign(capacity, 0.0f);
   }
   plans_.phase.assign(capacity, 0.0f);
@@ -269,7 +269,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                 {{pl.plant[0], pl.plant[1]},
                  {pl.hold[0], pl.hold[1]},
                  {pl.swing_progress[0], pl.swing_progress[1]},
-                 {pl.swing_rate[0], pl.swing_rate[1]},
+                 {pl.landing_s[0], pl.landing_s[1]},
                  {pl.gait_toe_y[0], pl.gait_toe_y[1]},
                  {pl.clip_toe_speed[0], pl.clip_toe_speed[1]},
                  pl.double_support});

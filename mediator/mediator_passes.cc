@@ -713,8 +713,8 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     // a standing clip's "both feet down" would otherwise keep a stepping foot locked while it
     // swings.
     float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
-    float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, swing_rate[2] = {0.0f, 0.0f};
-    float walk = 0.0f;
+    float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, walk = 0.0f;
+    float landing[2] = {0.0f, 0.0f}, landing_w[2] = {0.0f, 0.0f};
     float toe_speed[2] = {0.0f, 0.0f}, speed_w[2] = {0.0f, 0.0f};
     const float rate = playback_rate[slot], tr_rate = transition_rate[slot];
     // Gait phase per second (rate_phase_pass's), taken once a clip swings a foot: a gait clip's
@@ -762,14 +762,22 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
           // release that follows it, every other frame); not across a landing, where it restarts.
           const auto& sp = clip.swing_progress[s];
           const float a = sp[wrap(f0)], b = sp[wrap(f0 + 1)];
-          swing[s] += lw[k] * (b >= a ? a + fu * (b - a) : sp[f]);
-          if (b > a) {
+          const float progress = b >= a ? a + fu * (b - a) : sp[f];
+          swing[s] += lw[k] * progress;
+          if (progress > 0.0f) {
+            // This clip's swing: frame i of n at progress (i + 0.5) / n, so 1 / n a frame (from
+            // its first frame or its last alone as well), and it lands at progress 1.
+            const float per_frame = a > 0.0f ? (b > a ? b - a : 2.0f * (1.0f - a)) : 2.0f * b;
             float clip_rate = r;  // clip seconds per second
             if (clip.gait) {
               if (phase_rate < 0.0f) phase_rate = gait_frequency(lib, lc, lw).cycles_per_s * rate;
               clip_rate = clip.time_per_phase(phase[slot]) * phase_rate;
             }
-            swing_rate[s] += lw[k] * (b - a) * clip.clip.fps * clip_rate;
+            const float per_s = per_frame * clip.clip.fps * clip_rate;
+            if (per_s > 0.0f) {
+              landing[s] += lw[k] * (1.0f - progress) / per_s;
+              landing_w[s] += lw[k];
+            }
           }
         }
         hold[s] += lw[k] * clip.hold[s][f];
@@ -783,7 +791,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       out.plant[s][slot] = plant[s] / std::max(vote_w, 1e-6f);
       out.hold[s][slot] = hold[s] / std::max(vote_w, 1e-6f);
       out.swing_progress[s][slot] = swing[s] / std::max(vote_w, 1e-6f);
-      out.swing_rate[s][slot] = swing_rate[s] / std::max(vote_w, 1e-6f);
+      out.landing_s[s][slot] = landing_w[s] > 0.0f ? landing[s] / landing_w[s] : -1.0f;
       out.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : 0.0f;
       out.clip_toe_speed[s][slot] = speed_w[s] > 0.0f ? toe_speed[s] / speed_w[s] : -1.0f;
     }

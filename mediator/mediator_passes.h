@@ -253,7 +253,7 @@ struct ContactPlans {
   std::span<float> plant[2];           // "a lock may start", 0..1
   std::span<float> hold[2];            // "keep the lock", 0..1
   std::span<float> swing_progress[2];  // 0 at lift-off, 1 at landing
-  std::span<float> swing_rate[2];      // its rate at this frame's playback [1/s] (0: on the ground)
+  std::span<float> landing_s[2];       // when the clips land the foot [s] (< 0: none has it up)
   std::span<float> gait_toe_y[2];      // the gait clips' own toe height [m]
   std::span<float> clip_toe_speed[2];  // the voting clips' own ball speed [m/s] (< 0: unknown)
   std::span<float> double_support;     // share of the voting clips that walk, 0..1

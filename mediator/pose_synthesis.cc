@@ -747,6 +747,12 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   glm::vec3 goal[2], anim_toe[2], anim_vel[2];
   bool pinned[2] = {false, false};
   float swing_before[2];  // each foot's swing progress last frame
+  if (pl.fresh[slot]) {
+    // A new agent's feet start free: the first foot's rules read the other's state, which is
+    // otherwise still the slot's previous agent's.
+    locks_.lock[static_cast<size_t>(slot) * 2] = FootLock();
+    locks_.lock[static_cast<size_t>(slot) * 2 + 1] = FootLock();
+  }
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     // The clip's toe, no lower than the gait clips alone have it: a walk blended with a standing
@@ -829,21 +835,24 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       const glm::vec3 hip_p = translation_of(world[skeleton_.hip(sd)]);
       const float toward = ground_length(hip_p.x - g.x, hip_p.z - g.z);
       if (toward > 1e-4f) {
-        // Moved toward the hip over the floor as far as the leg needs to reach it now, and from
-        // where the hip will be when the other foot lands (the other foot's swing at its rate,
-        // the body at its speed in its direction of travel); never past the hip.
+        // Moved toward the hip over the floor as far as the leg needs to reach it now, and, with
+        // the heel as high as it rises (as a stance foot pushing off has it), from where the hip
+        // will be when the other foot lands (the clips' landing time, the body at its speed in
+        // its direction of travel); never past the hip.
         const glm::vec3 u((hip_p.x - g.x) / toward, 0.0f, (hip_p.z - g.z) / toward);
-        const glm::vec3 ankle = translation_of(world[skeleton_.ankle(sd)]) + g -
-                                translation_of(world[skeleton_.toe(sd)]);
+        const glm::vec3 d =
+            translation_of(world[skeleton_.ankle(sd)]) - translation_of(world[skeleton_.toe(sd)]);
         const float reach = kIkSoften * kIkMaxExtension * library_.leg_length_m[side];
-        float t = move_to_reach(ankle - hip_p, u, reach);
-        const float rate = pl.swing_rate[1 - side][slot];
-        const float progress = pl.swing_progress[1 - side][slot];
-        if (alone && rate > 0.0f && progress < 1.0f) {
-          const float ahead = pl.speed_m_s[slot] * (1.0f - progress) / rate;
+        float t = move_to_reach(g + d - hip_p, u, reach);
+        const float landing_s = pl.landing_s[1 - side][slot];
+        const glm::vec3 across = glm::cross(d, glm::vec3(0, 1, 0));
+        if (alone && landing_s >= 0.0f && glm::length(across) > 1e-6f) {
+          const float ahead = pl.speed_m_s[slot] * landing_s;
           const float yaw = pl.travel_yaw[slot];
           const glm::vec3 hip_then = hip_p + ahead * glm::vec3(std::sin(yaw), 0.0f, std::cos(yaw));
-          t = std::max(t, move_to_reach(ankle - hip_then, u, reach));
+          const glm::vec3 raised =
+              glm::angleAxis(heel_pivot::heel_room(d), glm::normalize(across)) * d;
+          t = std::max(t, move_to_reach(g + raised - hip_then, u, reach));
         }
         g += std::min(t, toward) * u;
       }
