@@ -501,9 +501,9 @@ void PoseSynthesizer::fk(glm::mat4* world, const glm::quat* rot, const glm::vec3
 }
 
 // Where an agent's world joints are posed: a crowd's far larger than the caches in the thread's
-// scratch (its lines stay in L1 for the whole agent), then streamed past the caches into world_ as
-// the palettes are (finish_pose), rather than read for ownership line by line; a small crowd's
-// straight in world_, which stays cached.
+// scratch (its lines stay in L1 for the whole agent), then streamed past the caches into world_
+// (finish_pose), rather than read for ownership line by line; a small crowd's straight in world_,
+// which stays cached.
 glm::mat4* PoseSynthesizer::world_of(int slot, Scratch& s) {
   return stream_world_ ? s.world.data() : world_.data() + static_cast<size_t>(slot) * num_joints_;
 }

@@ -63,7 +63,7 @@ struct FrameSnapshot {
 struct PipelineTimes {
   double sim_ms = 0.0;       // CrowdSource::step (0 in follow())
   double mediator_ms = 0.0;  // plan, snapshot and apply_feedback
-  double pose_ms = 0.0;      // pose synthesis (and skinning palettes)
+  double pose_ms = 0.0;      // pose synthesis (not the palettes: update_palettes)
   double measure_ms = 0.0;   // metrics and frame hooks: measurement, not the animation's cost
   double measure_cpu_ms = 0.0;  // their CPU time (they run on the calling thread alone)
 };

@@ -311,7 +311,7 @@ TEST(CrowdPipelineLod, LevelChangesCauseNoJointJumpsWithCoarseJoints) {
   expect_no_joint_jumps(*lib);
 }
 
-// Per-frame code allocates nothing, with LOD too (walkers over every level, metrics on).
+// Per-frame code allocates nothing, with LOD too (walkers over every level, metrics on, palettes).
 TEST(CrowdPipelineLod, StepAllocatesNothing) {
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
   std::vector<test::Script> scripts;
@@ -324,7 +324,10 @@ TEST(CrowdPipelineLod, StepAllocatesNothing) {
   for (int f = 0; f < 30; ++f) ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
   for (int level = 0; level < kNumLodLevels; ++level) EXPECT_GT(pipeline.lod().counts()[level], 0);
   const int64_t before = test::allocations_so_far();
-  for (int f = 0; f < 60; ++f) ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+  for (int f = 0; f < 60; ++f) {
+    ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+    pipeline.update_palettes();
+  }
   EXPECT_EQ(test::allocations_so_far() - before, 0);
 }
 
