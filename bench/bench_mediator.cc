@@ -1,8 +1,9 @@
 // Mediator planning and pose synthesis (sample, blend, FK, torso twist, foot IK; skinning
-// palettes are the upload's, CrowdPipeline::update_palettes, not measured here), microseconds per agent per frame at 1,000 agents, single thread, for three skeletons:
-// the built-in humanoid (25 joints), the CMU walk + run (31) and the Quaternius mannequin (53).
-// The crowd is the plaza scenario on social forces, stepped for two seconds first. The frame is
-// CrowdPipeline's; each iteration runs a whole frame and reports one stage's time (manual time).
+// palettes are the upload's, CrowdPipeline::update_palettes, not measured here), microseconds per
+// agent per frame at 1,000 agents, single thread, for three skeletons: the built-in humanoid (25
+// joints), the CMU walk + run (31) and the Quaternius mannequin (53). The crowd is the plaza
+// scenario on social forces, stepped for two seconds first. The frame is CrowdPipeline's; each
+// iteration runs a whole frame and reports one stage's time (manual time).
 #include <cstdlib>
 #include <string>
 
