@@ -23,6 +23,14 @@ inline float heel_room(const glm::vec3& d) {
   return std::max(0.0f, kMaxHeelOff - std::asin(std::clamp(d.y / len, -1.0f, 1.0f)));
 }
 
+// The toe -> ankle vector d with the heel as high as it rises (pitched up about the toe by
+// heel_room(d)); d itself for a foot standing straight up.
+inline glm::vec3 fully_raised(const glm::vec3& d) {
+  const glm::vec3 across = glm::cross(d, glm::vec3(0.0f, 1.0f, 0.0f));
+  if (glm::length(across) <= 1e-6f) return d;
+  return glm::angleAxis(heel_room(d), glm::normalize(across)) * d;
+}
+
 // A foot whose ball is this much higher [rad of pitch] over its floor than its ankle is over its
 // own stands on its heel, rolling down onto the ball (a heel strike lands some 15-25 deg toe-up);
 // a flat foot, captured or not, is within a few degrees of 0.

@@ -45,7 +45,7 @@ struct MediatorParams {
   // gives); with `feedback` on and a source that takes it, the simulator is given the held
   // position and speed (no hold otherwise).
   // Off by default: its estimate of the reach is cautious, and ordinary walking is slowed too
-  // (the mannequin's corridor crowd by 13%; README).
+  // (the mannequin's corridor crowd by 7%; README).
   bool support_hold = false;
   // 8. Feedback to the simulator.
   bool feedback = true;

@@ -132,7 +132,6 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   placed_xz_.assign(capacity, glm::vec2(0.0f));
   root_offset_.assign(capacity, glm::vec2(0.0f));
   support_reach_.assign(capacity, SupportReach{});
-  swing_prev_.assign(capacity * 2, 0.0f);
   locks_.lock.assign(capacity * 2, FootLock());
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
@@ -746,7 +745,6 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                           glide_halflife_s(P)};
   glm::vec3 goal[2], anim_toe[2], anim_vel[2];
   bool pinned[2] = {false, false};
-  float swing_before[2];  // each foot's swing progress last frame
   if (pl.fresh[slot]) {
     // A new agent's feet start free: the first foot's rules read the other's state, which is
     // otherwise still the slot's previous agent's.
@@ -813,8 +811,6 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     anim_vel[side] = in.fresh ? glm::vec3(0.0f) : (in.anim_toe - in.anim_toe_prev) / dt;
 
     locks_.anim_toe[k] = anim_toe[side];
-    swing_before[side] = swing_prev_[k];
-    swing_prev_[k] = pl.swing_progress[side][slot];
     const FootLockState st = locks_.lock[k].state;
     pinned[side] = st == FootLockState::kLocked || st == FootLockState::kStepping;
   }
@@ -845,14 +841,11 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
         const float reach = kIkSoften * kIkMaxExtension * library_.leg_length_m[side];
         float t = move_to_reach(g + d - hip_p, u, reach);
         const float landing_s = pl.landing_s[1 - side][slot];
-        const glm::vec3 across = glm::cross(d, glm::vec3(0, 1, 0));
-        if (alone && landing_s >= 0.0f && glm::length(across) > 1e-6f) {
+        if (alone && landing_s >= 0.0f) {
           const float ahead = pl.speed_m_s[slot] * landing_s;
           const float yaw = pl.travel_yaw[slot];
           const glm::vec3 hip_then = hip_p + ahead * glm::vec3(std::sin(yaw), 0.0f, std::cos(yaw));
-          const glm::vec3 raised =
-              glm::angleAxis(heel_pivot::heel_room(d), glm::normalize(across)) * d;
-          t = std::max(t, move_to_reach(g + raised - hip_then, u, reach));
+          t = std::max(t, move_to_reach(g + heel_pivot::fully_raised(d) - hip_then, u, reach));
         }
         g += std::min(t, toward) * u;
       }
@@ -960,10 +953,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       // This foot carries the body alone: the hip can go no further from it than the leg reaches
       // with the heel as high as it rises and the pelvis as low as it drops (the mediator holds
       // the root within that next frame, MediatorParams::support_hold).
-      glm::vec3 far_ankle = goal_ankle;
-      if (glm::length(pitch_axis) > 0.5f) {
-        far_ankle = toe_goal + glm::angleAxis(heel_pivot::heel_room(d), pitch_axis) * d;
-      }
+      const glm::vec3 far_ankle = toe_goal + heel_pivot::fully_raised(d);
       const float dy = hip_p.y - (kMaxDrop - drop_[slot]) - far_ankle.y;
       const float r = limit > dy ? std::sqrt(limit * limit - dy * dy) : 0.0f;
       SupportReach& sr = support_reach_[slot];
@@ -971,14 +961,12 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
           glm::vec2(far_ankle.x - (hip_p.x - placed[3].x), far_ankle.z - (hip_p.z - placed[3].z));
       sr.radius = r;
       // When the other foot comes down: a re-planting step when its time is up; a foot in the
-      // clips' swing when its progress, at its rate over the last frame, reaches 1.
+      // clips' swing when the clips land it (AnimationPlans::landing_s).
       const FootLock& other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)];
-      const float progress = pl.swing_progress[1 - side][slot];
-      const float rate = (progress - swing_before[1 - side]) / dt;
       if (other.state == FootLockState::kStepping) {
         sr.landing_s = std::max(0.0f, lp.step_time_s - other.timer_s);
-      } else if (!pl.fresh[slot] && rate > 1e-3f && progress > 0.0f && progress < 1.0f) {
-        sr.landing_s = (1.0f - progress) / rate;
+      } else {
+        sr.landing_s = pl.landing_s[1 - side][slot];
       }
     }
     if (glm::length(goal_ankle - hip_p) > limit + 1e-3f &&

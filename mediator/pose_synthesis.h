@@ -81,8 +81,8 @@ class PoseSynthesizer {
     return {t.x + o.x, t.y, t.z + o.y};
   }
   // Makes the skinning palettes (world * inverse bind) of the slots posed since the last call:
-  // the renderer's work (METRICS.md counts it in `upload`), done only where palettes are drawn or
-  // read, not in run(). Nothing without make_palettes.
+  // the renderer's work, done only where palettes are drawn or read (before an upload), not in
+  // run(). Nothing without make_palettes.
   void update_palettes();
   // Every slot's skinning palette as of the last update_palettes(), slot after slot (empty without
   // make_palettes); drawn with root_offset added to their translations, like world().
@@ -172,7 +172,6 @@ class PoseSynthesizer {
   std::vector<glm::vec2> placed_xz_;  // root (x, z) [m] the slot's world joints are placed at
   std::vector<glm::vec2> root_offset_;    // root_offset(slot)
   std::vector<SupportReach> support_reach_;  // support_reach()
-  std::vector<float> swing_prev_;            // per foot: its swing progress last frame
   FootLocks locks_;
   std::unique_ptr<tbb::enumerable_thread_specific<Scratch>> scratch_;
   std::vector<int> subtree_end_;  // subtree_ends(skeleton_)

@@ -100,8 +100,8 @@ class CrowdPipeline {
   const PoseSynthesizer& poses() const { return *poses_; }
   const MediatorParams& params() const { return mediator_->params(); }
   void set_params(const MediatorParams& params) { mediator_->set_params(params); }
-  // Makes the skinning palettes of the agents posed since the last call (the renderer's work, in
-  // METRICS.md's `upload`: a step does not make them); call it before reading palettes().
+  // Makes the skinning palettes of the agents posed since the last call (the renderer's work,
+  // timed as its upload: a step does not make them); call it before reading palettes().
   void update_palettes() { poses_->update_palettes(); }
   // Skinning palettes in slot order, num_joints() matrices per slot: slots [0, num_slots()),
   // empty without make_palettes, as of the last update_palettes(). Slots no live agent holds keep
