@@ -483,7 +483,7 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       st.weight[slot] = st.time_s[slot] = st.waited_s[slot] = st.lag_m[slot] = 0.0f;
       st.min_cadence[slot] = 0.0f;
       st.rate[slot] = 1.0f;
-      st.still_s[slot] = st.moving_s[slot] = st.slowing_s[slot] = 0.0f;
+      st.still_s[slot] = st.moving_s[slot] = 0.0f;
       st.prev_speed_m_s[slot] = v;
       st.prev_phase[slot] = phase[slot];
       return;
@@ -491,21 +491,15 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     const float accel = (v - st.prev_speed_m_s[slot]) / dt;
     const float prev_phase = st.prev_phase[slot];
     st.prev_speed_m_s[slot] = v;
-    // A start is seen on the first frame the agent moves after standing kTransitionSettle, and
-    // is due from then until it plays or the agent has moved as long (a stop still fading out
-    // as the agent sets off delays it by a few frames).
-    const bool start_due = !stand && st.still_s[slot] >= kTransitionSettle;
-    const bool start_seen = start_due && st.moving_s[slot] == 0.0f;
+    const bool start_seen = !stand && st.still_s[slot] >= kTransitionSettle;
     const bool stop_seen = stand && st.moving_s[slot] >= kTransitionSettle;
     if (stand) {
-      if (st.moving_s[slot] > 0.0f) st.still_s[slot] = 0.0f;  // a new stretch of standing
       st.still_s[slot] += dt;
       st.moving_s[slot] = 0.0f;
     } else {
       st.moving_s[slot] += dt;
-      if (st.moving_s[slot] >= kTransitionSettle) st.still_s[slot] = 0.0f;
+      st.still_s[slot] = 0.0f;
     }
-    st.slowing_s[slot] = !stand && accel < 0.0f ? st.slowing_s[slot] + dt : 0.0f;
     TransitionStage& stage = st.stage[slot];
     int16_t& index = st.index[slot];
     float& t = st.time_s[slot];
@@ -519,8 +513,8 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       st.min_cadence[slot] = 0.0f;
     }
     if (stop_seen) ++counts[kStopsSeen];
-    if (start_seen) ++counts[kStartsSeen];
-    if (start_due) {
+    if (start_seen) {
+      ++counts[kStartsSeen];
       // Played unless a stop is still playing or fading out (one waiting for its phase gives way).
       const int k = play ? nearest_transition(lib, TransitionKind::kStart, v) : -1;
       if (k >= 0 && (stage == TransitionStage::kNone || stage == TransitionStage::kWaiting)) {
@@ -533,7 +527,6 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
         while (t < tr.moving_to_s && tr.speed_at(t) < v) t += 1.0f / tr.fps;
         st.lag_m[slot] = 0.0f;
         ++counts[kStartsPlayed];
-        st.still_s[slot] = 0.0f;  // no longer due
       }
     }
     if (play && stage == TransitionStage::kNone && !stand &&
@@ -542,14 +535,10 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       // clip's own stopping time (with some slack), from a speed the clip walks at.
       // It is entered where the clip has slowed to the agent's speed (a slow agent plays only
       // the stop's last steps), or later where the clip is slower still but the agent can play
-      // it and still come to rest in time. An agent that has slowed for kTransitionSettle more
-      // gently than that (as a slowdown begins, a deceleration still growing looks gentle) comes
-      // to rest after the clip: it enters where the clip has slowed to its speed or up to a step
-      // later, and the clip, at its standing end, holds it while it creeps on (below). The stop
-      // nearest in speed, or its mirror image (the same stop ending on the other foot), at the
-      // entry whose step comes soonest in the gait, so the agent waits at most about a step for
-      // it (an agent in a jam that slows to rest in a step or two would otherwise stand before
-      // its stop begins).
+      // it and still come to rest in time. The stop nearest in speed, or its mirror image (the
+      // same stop ending on the other foot), at the entry whose step comes soonest in the gait,
+      // so the agent waits at most about a step for it (an agent in a jam that slows to rest in
+      // a step or two would otherwise stand before its stop begins).
       const int nearest = nearest_transition(lib, TransitionKind::kStop, v);
       const float near_v = nearest >= 0 ? lib.transitions[nearest].moving_speed_m_s : 0.0f;
       const float to_rest = v / -accel;
@@ -561,20 +550,19 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
             std::abs(tr.moving_speed_m_s - near_v) > 0.01f * near_v) {
           continue;
         }
-        const float frame = 1.0f / tr.fps;
         float entry = tr.moving_from_s;
-        while (entry < tr.moving_to_s && tr.speed_at(entry) > v) entry += frame;
-        if (v > 1.3f * tr.moving_speed_m_s || entry >= tr.moving_to_s) continue;
-        const bool gentle = to_rest > 1.25f * (tr.moving_to_s - entry) + 0.2f;
-        if (gentle && st.slowing_s[slot] < kTransitionSettle) continue;
-        // Later entries: as long as the agent can play them (its speed within the clip's at the
-        // fastest rate) and still comes to rest in time, or, slowing gently, within a step.
-        const float step_s = 0.5f * lib.clips[tr.cycle_clip].cycle_s;
+        while (entry < tr.moving_to_s && tr.speed_at(entry) > v) entry += 1.0f / tr.fps;
+        if (!(to_rest <= 1.25f * (tr.moving_to_s - entry) + 0.2f &&
+              v <= 1.3f * tr.moving_speed_m_s && entry < tr.moving_to_s)) {
+          continue;
+        }
+        // Later entries, where the clip is slower still, as long as the agent can play them
+        // (its speed within the clip's at the fastest rate) and still comes to rest in time.
+        const float frame = 1.0f / tr.fps;
         float last = entry;
         while (last + frame < tr.moving_to_s &&
                tr.speed_at(last + frame) * P.max_playback_rate >= v &&
-               (gentle ? last + frame <= entry + step_s
-                       : to_rest <= 1.25f * (tr.moving_to_s - last - frame) + 0.2f)) {
+               to_rest <= 1.25f * (tr.moving_to_s - last - frame) + 0.2f) {
           last += frame;
         }
         for (float e = entry; e <= last + 1e-4f; e += frame) {
@@ -654,10 +642,8 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     if (stage == TransitionStage::kPlaying) {
       // Left when it is nearly over (a start hands over to the cycle while the clip still walks,
       // a stop once the clip stands), or when the agent does the opposite of what it plays.
-      // A stop that has come to its standing end while the agent still creeps on holds it (the
-      // feet planted, re-placed by steps as a standing agent's are) until the agent stands.
       const bool over = start ? t >= tr.duration_s - P.blend_time_s * st.rate[slot]
-                              : t >= tr.duration_s - P.blend_time_s && stand;
+                              : t >= tr.duration_s - P.blend_time_s;
       // A stop is also left when the agent walks on faster than the clip can follow.
       const float reach = tr.speed_at(t) * P.max_playback_rate + kStill;
       // A start is left when the agent stops again or creeps on slower than the clip can go.

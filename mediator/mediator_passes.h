@@ -219,7 +219,6 @@ struct TransitionState {
   std::span<float> lag_m;  // playing: the agent's distance travelled minus the clip's [m]
   std::span<float> prev_speed_m_s, prev_phase;
   std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
-  std::span<float> slowing_s;          // how long the agent has slowed down, without a break [s]
   std::span<uint32_t> counts;          // [slot * kNumCounts + TransitionCount], cumulative
 };
 // The agent has stood (or moved) at least this long before a start (stop) counts.
