@@ -26,6 +26,7 @@ constexpr Label kLabels[] = {
     {"idle_step_distance_m", "Re-plant after drift of"},
     {"idle_step_time_s", "Re-planting step time"},
     {"support_hold", "Hold body at support foot"},
+    {"quicken_steps", "Quicken steps at reach"},
     {"feedback", "Feedback to simulator"},
     {"turn_feedback_deg", "Max path-to-legs angle"},
     {"max_accel_m_s2", "Max speed-up"},

@@ -23,6 +23,8 @@ struct SupportReach {
   glm::vec2 centre{0.0f};  // (x, z) [m]
   float radius = -1.0f;    // [m]; < 0: no such foot
   float landing_s = -1.0f;  // [s]
+  bool replanting =
+      false;  // the other foot is in a re-planting step (its own clock, not the clips')
 };
 
 // Per-slot plan for one frame, read by the pose synthesis pass and the metrics.

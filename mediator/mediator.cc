@@ -73,6 +73,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   scratch_target_.assign(capacity * nc, 0.0f);
   idle_time_.assign(capacity, 0.0f);
   cadence_scale_.assign(capacity, 1.0f);
+  reach_boost_.assign(capacity, 1.0f);
   tr_index_.assign(capacity, -1);
   tr_stage_.assign(capacity, TransitionStage::kNone);
   for (auto* v : {&tr_time_, &tr_weight_, &tr_waited_, &tr_min_cadence_, &tr_chosen_speed_,
@@ -251,14 +252,15 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
               {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
   const bool honoured = params_.feedback && policy == FeedbackPolicy::kHonoured;
   root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_,
-            support_reach_, honoured, root_speed_, hold_, hold_scale_);
+            support_hold_allowed_ ? support_reach_ : std::span<const SupportReach>(), honoured,
+            root_speed_, hold_, hold_scale_);
   facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw, pl.upper_yaw,
               rel_dir_, pl.layer_clip, pl.layer_weight);
   weights_pass(crowd, pl.speed_m_s, rel_dir_, tr_min_cadence_, {clip_weights_, scratch_target_},
                pl.layer_clip, pl.layer_weight, pl.blend_progress);
   rate_phase_pass(crowd, pl.layer_clip, pl.layer_weight, pl.speed_m_s, cadence_scale_, pl.lower_yaw,
-                  tr_weight_, pl.phase, idle_time_, pl.playback_rate, pl.gait_weight,
-                  pl.travel_yaw);
+                  tr_weight_, {support_reach_, pl.root_xz, vel_, reach_boost_}, pl.phase,
+                  idle_time_, pl.playback_rate, pl.gait_weight, pl.travel_yaw);
   transition_pass(crowd, pl.speed_m_s, pl.playback_rate, pl.standing, pl.layer_clip,
                   pl.layer_weight, pl.gait_weight, pl.phase,
                   {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_,

@@ -59,7 +59,13 @@ class Mediator {
   // whole time since its last plan. Empty (the default): every agent every frame. The span must
   // stay valid (capacity long) while it is set.
   void set_lod_due(std::span<const uint8_t> due_by_slot) { lod_due_ = due_by_slot; }
-  void set_support_reach(std::span<const SupportReach> by_slot) { support_reach_ = by_slot; }
+  // Last frame's support reach per slot (PoseSynthesizer::support_reach; empty: none): the rate
+  // pass quickens the steps by it, and the root pass holds the root in it (support_hold) only if
+  // `hold`, where the held position is fed back to a source. The span must stay valid while set.
+  void set_support_reach(std::span<const SupportReach> by_slot, bool hold) {
+    support_reach_ = by_slot;
+    support_hold_allowed_ = hold;
+  }
 
   const AnimationPlans& plans() const { return plans_; }
   const FeedbackBuffers& feedback() const { return feedback_; }
@@ -122,6 +128,7 @@ class Mediator {
   std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
   std::vector<float> idle_time_;           // clock of the standing clip
   std::vector<float> cadence_scale_;       // per-agent variety
+  std::vector<float> reach_boost_;         // rate pass, carried (ReachInput::boost)
   // Transitions (mediator_passes.h, TransitionState).
   std::vector<int16_t> tr_index_;
   std::vector<TransitionStage> tr_stage_;
@@ -137,6 +144,7 @@ class Mediator {
   // time [s], phase and root advance since its last plan.
   std::span<const uint8_t> lod_due_;
   std::span<const SupportReach> support_reach_;
+  bool support_hold_allowed_ = false;
   std::vector<glm::vec2> hold_;
   std::vector<float> hold_scale_;
   std::vector<float> root_speed_;  // the drawn root's speed last frame [m/s]

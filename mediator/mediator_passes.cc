@@ -362,12 +362,48 @@ GaitFrequency gait_frequency(const LocomotionLibrary& lib, const int16_t* lc, co
   return out;
 }
 
+namespace {
+
+// The factor on an agent's playback rate that brings its swinging foot down before the body has
+// gone beyond the reach of the foot that carries it alone (ReachInput, SupportReach), eased in
+// and out over kReachBoostTime; 1 while no foot carries the body alone or the landing comes in
+// time. A walker speeding up takes quicker steps: the swing ends sooner, rather than the
+// stance leg being overstretched, let go and re-pinned (the feet gliding or both in the air)
+// before the other foot lands.
+float reach_boost(const PassCrowd& c, const ReachInput& reach, int slot, float rate, float dt) {
+  float& boost = reach.boost[slot];
+  float goal = 1.0f;
+  if (!reach.support_reach.empty()) {
+    const SupportReach& sr = reach.support_reach[slot];
+    // (A re-planting step lands on its own clock: a faster gait does not bring it down sooner.)
+    if (sr.radius >= 0.0f && sr.landing_s > 0.0f && !sr.replanting) {
+      // Last frame's landing time was at last frame's factor: at the plain rate it is longer.
+      const float landing_s = sr.landing_s * boost;
+      const glm::vec2 from = reach.root_xz[slot] - sr.centre;
+      const float dist = glm::length(from);
+      // The body's speed away from the foot (the simulator's, filtered: a frame's jitter of the
+      // drawn root is no reason to step faster), and the time until it leaves the reach.
+      const float away = dist > 1e-4f ? glm::dot(reach.velocity[slot], from) / dist : 0.0f;
+      if (away > 1e-3f) {
+        const float leaves_s = std::max(sr.radius - dist, 0.0f) / away;
+        if (leaves_s < landing_s) goal = landing_s / std::max(leaves_s, dt);
+      }
+    }
+  }
+  goal = std::clamp(goal, 1.0f, std::max(1.0f, c.params.max_playback_rate / rate));
+  boost = approach(boost, goal, dt / kReachBoostTime);
+  return boost;
+}
+
+}  // namespace
+
 void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
                      std::span<const float> cadence_scale, std::span<const float> lower_yaw,
-                     std::span<const float> transition_weight, std::span<float> phase,
-                     std::span<float> idle_time_s, std::span<float> out_playback_rate,
-                     std::span<float> out_gait_weight, std::span<float> out_travel_yaw) {
+                     std::span<const float> transition_weight, ReachInput reach,
+                     std::span<float> phase, std::span<float> idle_time_s,
+                     std::span<float> out_playback_rate, std::span<float> out_gait_weight,
+                     std::span<float> out_travel_yaw) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   for_each_agent(c, [&](size_t, int slot) {
@@ -413,12 +449,19 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       }
       if (best >= 0.0f) phase[slot] = best;
     }
+    if (c.fresh[slot] || !(gait_w > 0.0f) || P.mode == MediatorMode::kNaive || !P.quicken_steps) {
+      reach.boost[slot] = 1.0f;
+    }
     if (gait_w > 0.0f) {
       if (P.mode == MediatorMode::kNaive) {
         rate = 1.0f;
       } else if (native > 1e-3f) {
         rate = std::clamp(speed_m_s[slot] / native * cadence_scale[slot], P.min_playback_rate,
                           P.max_playback_rate);
+        if (P.quicken_steps) {
+          rate = std::clamp(rate * reach_boost(c, reach, slot, rate, dt), P.min_playback_rate,
+                            P.max_playback_rate);
+        }
       }
       phase[slot] = near_fmod(phase[slot] + freq * rate * dt, 1.0f);
     }

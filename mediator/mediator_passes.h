@@ -185,12 +185,30 @@ void weights_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
 // clip's clock, the share of gait clips and the travel direction the played clips imply [rad].
 // An agent setting off from standing (no gait clip in last frame's blend, no transition playing:
 // `transition_weight` is last frame's) starts its gait phase where a foot leaves the ground.
+// In APM the rate is raised (within the limits) while the body would otherwise leave the reach of
+// the foot that carries it alone before the other foot lands: a walker speeding up, or one the
+// simulator pushes on, takes quicker steps (reach_boost in mediator_passes.cc).
+//
+// Where the drawn root is (root pass, this frame) and goes (the filtered velocity) against the
+// reach of a foot that carries the body alone (last frame's pose, PoseSynthesizer::support_reach;
+// empty: none), and the factor on the playback rate that lands the other foot before the body
+// leaves that reach (carried per slot).
+struct ReachInput {
+  std::span<const SupportReach> support_reach;
+  std::span<const glm::vec2> root_xz;
+  std::span<const glm::vec2> velocity;
+  std::span<float> boost;
+};
+// The reach factor eases in and out over this time [s] (a quarter of a walking swing): the
+// cadence rises within the step that needs it, with no jump in every joint's speed.
+inline constexpr float kReachBoostTime = 0.1f;
 void rate_phase_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
                      std::span<const float> cadence_scale, std::span<const float> lower_yaw,
-                     std::span<const float> transition_weight, std::span<float> phase,
-                     std::span<float> idle_time_s, std::span<float> out_playback_rate,
-                     std::span<float> out_gait_weight, std::span<float> out_travel_yaw);
+                     std::span<const float> transition_weight, ReachInput reach,
+                     std::span<float> phase, std::span<float> idle_time_s,
+                     std::span<float> out_playback_rate, std::span<float> out_gait_weight,
+                     std::span<float> out_travel_yaw);
 
 // --- transitions --------------------------------------------------------------------------------
 // Per slot, carried: the start or stop clip an agent plays (LocomotionLibrary::transitions) as a

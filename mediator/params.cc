@@ -54,6 +54,10 @@ constexpr ParamInfo kInfos[] = {
      "hold the body within reach of a foot that carries it alone, fed back to the simulator "
      "(needs feedback; slows walking too)",
      0.0f, 1.0f, K::kBool, nullptr, &P::support_hold},
+    {"quicken_steps", "on/off",
+     "step faster (within the rate limits) while the body would leave the reach of a foot that "
+     "carries it alone before the other foot lands",
+     0.0f, 1.0f, K::kBool, nullptr, &P::quicken_steps},
     {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator",
      0.0f, 1.0f, K::kBool, nullptr, &P::feedback},
     {"turn_feedback_deg", "deg",

@@ -47,6 +47,10 @@ struct MediatorParams {
   // Off by default: its estimate of the reach is cautious, and ordinary walking is slowed too
   // (the mannequin's corridor crowd by 7%; README).
   bool support_hold = false;
+  // Quicker steps (a higher playback rate, within the limits) while the body would leave the
+  // reach of the foot that carries it alone before the other foot lands (rate_phase_pass): the
+  // swing ends sooner, rather than the support foot being overstretched and let go.
+  bool quicken_steps = true;
   // 8. Feedback to the simulator.
   bool feedback = true;
   float turn_feedback_deg = 10.0f;  // [deg] [Limit: 0..180] forward-only libraries: velocity kept

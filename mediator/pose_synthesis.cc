@@ -948,11 +948,12 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       goal_ankle = toe_goal + r * d;
       ankle_world_rot[side] = r * ankle_world_rot[side];
     }
-    if (P.support_hold && !letting_go && locks_.lock[k].state == FootLockState::kLocked &&
+    if (!letting_go && locks_.lock[k].state == FootLockState::kLocked &&
         locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state != FootLockState::kLocked) {
       // This foot carries the body alone: the hip can go no further from it than the leg reaches
-      // with the heel as high as it rises and the pelvis as low as it drops (the mediator holds
-      // the root within that next frame, MediatorParams::support_hold).
+      // with the heel as high as it rises and the pelvis as low as it drops. Next frame the
+      // mediator quickens the steps so the other foot lands before the body gets there
+      // (rate_phase_pass), and with MediatorParams::support_hold holds the root within it.
       const glm::vec3 far_ankle = toe_goal + heel_pivot::fully_raised(d);
       const float dy = hip_p.y - (kMaxDrop - drop_[slot]) - far_ankle.y;
       const float r = limit > dy ? std::sqrt(limit * limit - dy * dy) : 0.0f;
@@ -963,7 +964,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
       // When the other foot comes down: a re-planting step when its time is up; a foot in the
       // clips' swing when the clips land it (AnimationPlans::landing_s).
       const FootLock& other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)];
-      if (other.state == FootLockState::kStepping) {
+      sr.replanting = other.state == FootLockState::kStepping;
+      if (sr.replanting) {
         sr.landing_s = std::max(0.0f, lp.step_time_s - other.timer_s);
       } else {
         sr.landing_s = pl.landing_s[1 - side][slot];

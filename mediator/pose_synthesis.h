@@ -71,8 +71,9 @@ class PoseSynthesizer {
   glm::vec2 root_offset(int slot) const { return root_offset_[slot]; }
   std::span<const glm::vec2> root_offsets() const { return root_offset_; }
   // Per slot, where a foot that carries the body alone (pinned, the other foot not) lets the root
-  // go, and when the other foot comes down (SupportReach): the mediator holds the root within
-  // that reach until then (and feeds the held position back), so the support foot stays pinned.
+  // go, and when the other foot comes down (SupportReach): the mediator quickens the steps so the
+  // other foot lands before the body leaves that reach, and with support_hold holds the root
+  // within it until then (and feeds the held position back), so the support foot stays pinned.
   std::span<const SupportReach> support_reach() const { return support_reach_; }
   // One joint's world position as drawn this frame (world(slot)'s translation + root_offset).
   glm::vec3 joint_position(int slot, int joint) const {

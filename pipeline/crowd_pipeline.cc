@@ -80,10 +80,10 @@ Status CrowdPipeline::animate(const AgentFrame& frame, FeedbackPolicy policy, Cr
   const bool lod = lod_params_.enabled;
   if (lod) lod_.assign(mediator_->plans(), lod_params_, frames_run_);
   mediator_->set_lod_due(lod ? lod_.due() : std::span<const uint8_t>());
-  // The support hold moves the root only where the held position is fed back: not in a lane
-  // that follows another pipeline's frame (no source takes its feedback).
-  mediator_->set_support_reach(source ? poses_->support_reach()
-                                      : std::span<const SupportReach>());
+  // The support's reach quickens the steps in every lane; the support hold moves the root only
+  // where the held position is fed back: not in a lane that follows another pipeline's frame (no
+  // source takes its feedback).
+  mediator_->set_support_reach(poses_->support_reach(), source != nullptr);
   // plan() validates the frame before it writes anything: on failure the previous frame's plans,
   // snapshot and poses are untouched and still drawable.
   GK_RETURN_IF_ERROR(mediator_->plan(frame, dt_s, policy));

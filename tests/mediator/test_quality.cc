@@ -132,9 +132,10 @@ TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
 // The same jam with the mannequin's keyframed clips and the support hold on (MediatorParams::
 // support_hold, off by default): within the support-foot and limb-pop bounds, and the hold keeps
 // the support feet put (without it, a foot carrying the body alone is dragged or let go as the
-// body lurches on: here support skate 0.0052 against 0.0040). A jam is chaotic, and any change
-// elsewhere moves one run's figures by a few tenths of themselves: the float is compared over
-// three seeds' jams (0.015 against 0.0095 in the mean; seed 1 alone 0.016 against 0.012).
+// body lurches on: its support skate is higher). The float the hold once kept well down too (0.015
+// against 0.0095 over three seeds' jams) is now mostly the quickened steps' doing (the rate pass
+// lands the other foot before the body leaves the support's reach): 0.0100 unheld against 0.0091
+// held over those seeds, too close in a chaotic jam to be compared here.
 TEST(Quality, JammedBodiesAreHeldByTheirSupportFoot) {
   GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
   auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
@@ -154,14 +155,6 @@ TEST(Quality, JammedBodiesAreHeldByTheirSupportFoot) {
   EXPECT_EQ(apm.pop_count, 0);
   const MetricsReport unheld = run_source(*c, *lib, MediatorMode::kApm);
   EXPECT_GT(unheld.feet.support_skate_ratio, apm.feet.support_skate_ratio);
-  double float_held = apm.feet.float_ratio, float_unheld = unheld.feet.float_ratio;
-  for (const uint64_t seed : {2, 3}) {
-    auto held_crowd = scenario_crowd("bottleneck", true, seed);
-    auto unheld_crowd = scenario_crowd("bottleneck", true, seed);
-    float_held += run_source(*held_crowd, *lib, MediatorMode::kApm, hold).feet.float_ratio;
-    float_unheld += run_source(*unheld_crowd, *lib, MediatorMode::kApm).feet.float_ratio;
-  }
-  EXPECT_GT(float_unheld, 1.2 * float_held);
 }
 
 // Captured clips of another kind (CMU subject 16: 30 fps, centimetres, a start, a stop, turns and

@@ -5,6 +5,7 @@
 // gives), keeps its direction, and the feedback gives the simulator the held position and the
 // speed kept.
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -257,14 +258,137 @@ TEST(SupportHold, PoseSynthesisPublishesTheReachOfASingleSupportFoot) {
   // slows, as a start's first step does, is expected to land late).
   EXPECT_LT(late, published / 50);
 
-  // Off (the default), nothing is published, and the crowd is not held.
+  EXPECT_GT(published, single / 2);
+
+  // Off (the default), the reach is published all the same: the rate pass quickens the steps by
+  // it (ReachBoost below), though the root pass holds nothing.
   test::ScriptedCrowd plain(scripts, /*honour_feedback=*/true);
   CrowdPipeline off(lib, MediatorParams{}, test::test_pipeline_options(plain.capacity(), kDt));
-  for (int f = 0; f < 120; ++f) {
+  int published_off = 0;
+  for (int f = 0; f < 240; ++f) {
     ASSERT_TRUE(off.step(plain, kDt).ok());
-    for (const SupportReach& sr : off.poses().support_reach()) EXPECT_LT(sr.radius, 0.0f);
+    for (size_t i = 0; i < plain.capacity(); ++i) {
+      if (off.poses().support_reach()[off.mediator().plans().slot_of_agent[i]].radius >= 0.0f) {
+        ++published_off;
+      }
+    }
   }
-  EXPECT_GT(published, single / 2);
+  EXPECT_GT(published_off, 100);
+}
+
+// The rate pass alone: one agent walking the built-in walk at its own speed (rate 1), its support
+// foot's reach about to be left. Quicker steps are asked for exactly while the body would leave
+// the reach before the other foot lands, eased in and out over kReachBoostTime, never beyond the
+// rate limit; not for a re-planting step, whose landing the gait's rate does not bring sooner.
+struct RatePass {
+  const LocomotionLibrary& lib = test::builtin_library();
+  MediatorParams params;
+  std::vector<int32_t> slot_of_agent{0};
+  std::vector<uint8_t> fresh{0};
+  std::vector<int16_t> layer_clip = std::vector<int16_t>(kMaxBlendLayers, 0);
+  std::vector<float> layer_weight = std::vector<float>(kMaxBlendLayers, 0.0f);
+  std::vector<float> speed, cadence{1.0f}, lower_yaw{0.0f}, transition_weight{0.0f};
+  std::vector<float> phase{0.0f}, idle{0.0f}, rate{1.0f}, gait{1.0f}, travel{0.0f};
+  std::vector<glm::vec2> root_xz{glm::vec2(0.0f, 0.98f)}, vel{glm::vec2(0.0f, 1.2f)};
+  // The root is 0.48 m from the foot's centre, 0.01 m inside its reach, moving straight away.
+  std::vector<SupportReach> reach{SupportReach{glm::vec2(0.0f, 0.5f), 0.49f, 0.3f}};
+  std::vector<float> boost{1.0f};
+  RatePass() {
+    const DirectionGroup& g = lib.groups[lib.forward_group];
+    layer_clip[0] = static_cast<int16_t>(g.clips.front());  // the slowest forward walk
+    layer_weight[0] = 1.0f;
+    speed = {lib.clips[g.clips.front()].speed_m_s};
+  }
+  float step() {
+    const PassCrowd crowd{lib, params, kDt, slot_of_agent, fresh};
+    rate_phase_pass(crowd, layer_clip, layer_weight, speed, cadence, lower_yaw, transition_weight,
+                    {reach, root_xz, vel, boost}, phase, idle, rate, gait, travel);
+    return rate[0];
+  }
+};
+
+TEST(ReachBoost, StepsQuickenWhileTheBodyWouldLeaveTheReachBeforeTheLanding) {
+  RatePass a;
+  const float first = a.step();
+  // Eased in: up by a frame's share of kReachBoostTime, not at once.
+  EXPECT_NEAR(first, 1.0f + kDt / kReachBoostTime, 1e-4f);
+  float r = first;
+  for (int f = 0; f < 10; ++f) {
+    const float next = a.step();
+    EXPECT_GE(next, r - 1e-6f);
+    r = next;
+  }
+  EXPECT_NEAR(r, a.params.max_playback_rate, 1e-4f);  // asked for 0.3 s / one frame: the limit
+  // The other foot lands in time (the body 0.3 m inside the reach, 0.25 s at 1.2 m/s, landing in
+  // 0.2 s at the quickened rate, 0.27 s at the plain one): back to the plain rate, eased out.
+  a.reach[0].radius = 0.78f;
+  a.reach[0].landing_s = 0.2f;
+  const float easing = a.step();
+  EXPECT_LT(easing, r);
+  EXPECT_GT(easing, 1.0f);
+  for (int f = 0; f < 10; ++f) r = a.step();
+  EXPECT_NEAR(r, 1.0f, 1e-4f);
+}
+
+TEST(ReachBoost, NotForAReplantingStepNorWithoutASingleSupport) {
+  {
+    RatePass a;
+    a.reach[0].replanting = true;
+    for (int f = 0; f < 5; ++f) EXPECT_NEAR(a.step(), 1.0f, 1e-4f);
+  }
+  {
+    RatePass a;
+    a.reach[0].radius = -1.0f;  // both feet pinned, or none
+    for (int f = 0; f < 5; ++f) EXPECT_NEAR(a.step(), 1.0f, 1e-4f);
+  }
+  {
+    RatePass a;
+    a.vel[0] = glm::vec2(0.0f, -1.2f);  // walking back over the foot: no hurry
+    for (int f = 0; f < 5; ++f) EXPECT_NEAR(a.step(), 1.0f, 1e-4f);
+  }
+  {
+    RatePass a;
+    a.params.mode = MediatorMode::kNaive;  // naive plays the clips as they are
+    for (int f = 0; f < 5; ++f) EXPECT_NEAR(a.step(), 1.0f, 1e-4f);
+  }
+}
+
+// Through the pipeline, with the mannequin's clips (a walk at 1.05 m/s, a jog at 2.6): pedestrians
+// who set off briskly from a slow walk (0.3 -> 1.5 m/s in 0.7 s, as agents in a DetourCrowd
+// plaza do). The slow blend's steps are short and its swing long, so the body outran the support
+// foot before the other foot came down, and the stance leg was let go and re-pinned with both
+// feet off the floor. Quicker steps while the body would leave the support's reach keep a foot
+// down: float 0.0059 -> 0.0010, support slide 0.67 -> 0.39 cm/s; their support skate is higher
+// (0.0004 -> 0.0021, landings at the quicker pace), within its bound.
+TEST(ReachBoost, PedestriansSettingOffBrisklyKeepAFootDown) {
+  GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
+  auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  auto run = [&](bool quicken) {
+    std::vector<test::Script> scripts;
+    for (int i = 0; i < 12; ++i) {
+      const double t0 = 1.0 + 0.061 * i;  // setting off at every phase of the slow walk
+      scripts.push_back({glm::vec2(1.5f * static_cast<float>(i), 0.0f), [t0](double t) {
+                           const double u = std::clamp((t - t0) / 0.7, 0.0, 1.0);
+                           return glm::vec2(
+                               0.0f, static_cast<float>(0.3 + 1.2 * u * u * (3.0 - 2.0 * u)));
+                         }});
+    }
+    test::ScriptedCrowd crowd(scripts);
+    MediatorParams params;
+    params.quicken_steps = quicken;
+    CrowdPipeline pipeline(*lib, params, test::test_pipeline_options(crowd.capacity(), kDt));
+    for (int f = 0; f < 240; ++f) EXPECT_TRUE(pipeline.step(crowd, kDt).ok());
+    return pipeline.metrics()->finish();
+  };
+  const MetricsReport on = run(true), off = run(false);
+  EXPECT_LT(2.0 * on.feet.float_ratio, off.feet.float_ratio);
+  EXPECT_LT(on.feet.support_slide_cm_s, off.feet.support_slide_cm_s);
+  EXPECT_LE(on.feet.float_ratio, 0.01);
+  EXPECT_LE(on.feet.support_skate_ratio, 0.005);
+  EXPECT_LE(on.feet.support_slide_cm_s, 2.0);
+  EXPECT_LE(on.feet.limb_pop_rate, 1.0);
+  EXPECT_EQ(on.playback_outside_limits, 0.0);
 }
 
 }  // namespace
