@@ -62,6 +62,7 @@ class Mediator {
   // Last frame's support reach per slot (PoseSynthesizer::support_reach; empty: none): the rate
   // pass quickens the steps by it, and the root pass holds the root in it (support_hold) only if
   // `hold`, where the held position is fed back to a source. The span must stay valid while set.
+  // CrowdPipeline sets it every frame; a Mediator driven without one gets neither.
   void set_support_reach(std::span<const SupportReach> by_slot, bool hold) {
     support_reach_ = by_slot;
     support_hold_allowed_ = hold;

@@ -370,15 +370,17 @@ namespace {
 // time. A walker speeding up takes quicker steps: the swing ends sooner, rather than the
 // stance leg being overstretched, let go and re-pinned (the feet gliding or both in the air)
 // before the other foot lands.
-float reach_boost(const PassCrowd& c, const ReachInput& reach, int slot, float rate, float dt) {
+float reach_boost(const PassCrowd& c, const ReachInput& reach, int slot, float rate,
+                  float played_rate, float dt) {
   float& boost = reach.boost[slot];
   float goal = 1.0f;
   if (!reach.support_reach.empty()) {
     const SupportReach& sr = reach.support_reach[slot];
     // (A re-planting step lands on its own clock: a faster gait does not bring it down sooner.)
     if (sr.radius >= 0.0f && sr.landing_s > 0.0f && !sr.replanting) {
-      // Last frame's landing time was at last frame's factor: at the plain rate it is longer.
-      const float landing_s = sr.landing_s * boost;
+      // Last frame's landing time, at the rate played then: at this frame's plain rate, and a
+      // frame on.
+      const float landing_s = std::max(sr.landing_s * played_rate / rate - dt, 0.0f);
       const glm::vec2 from = reach.root_xz[slot] - sr.centre;
       const float dist = glm::length(from);
       // The body's speed away from the foot (the simulator's, filtered: a frame's jitter of the
@@ -390,8 +392,10 @@ float reach_boost(const PassCrowd& c, const ReachInput& reach, int slot, float r
       }
     }
   }
-  goal = std::clamp(goal, 1.0f, std::max(1.0f, c.params.max_playback_rate / rate));
-  boost = approach(boost, goal, dt / kReachBoostTime);
+  const float most = std::max(1.0f, c.params.max_playback_rate / rate);
+  goal = std::clamp(goal, 1.0f, most);
+  // From 1 to the fastest rate over kReachBoostTime at the most, at an even pace.
+  boost = approach(boost, goal, (c.params.max_playback_rate - 1.0f) * dt / kReachBoostTime);
   return boost;
 }
 
@@ -449,7 +453,10 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       }
       if (best >= 0.0f) phase[slot] = best;
     }
-    if (c.fresh[slot] || !(gait_w > 0.0f) || P.mode == MediatorMode::kNaive || !P.quicken_steps) {
+    // Not for a new agent (its slot's reach is the previous agent's), without gait clips, outside
+    // APM, nor while a start or stop plays (its own clock lands the feet).
+    if (c.fresh[slot] || !(gait_w > 0.0f) || !is_apm(c) || !P.quicken_steps ||
+        transition_weight[slot] > 0.0f) {
       reach.boost[slot] = 1.0f;
     }
     if (gait_w > 0.0f) {
@@ -458,9 +465,10 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       } else if (native > 1e-3f) {
         rate = std::clamp(speed_m_s[slot] / native * cadence_scale[slot], P.min_playback_rate,
                           P.max_playback_rate);
-        if (P.quicken_steps) {
-          rate = std::clamp(rate * reach_boost(c, reach, slot, rate, dt), P.min_playback_rate,
-                            P.max_playback_rate);
+        if (P.quicken_steps && !c.fresh[slot] && !(transition_weight[slot] > 0.0f)) {
+          const float played = out_playback_rate[slot];  // last frame's, overwritten below
+          rate = std::clamp(rate * reach_boost(c, reach, slot, rate, played, dt),
+                            P.min_playback_rate, P.max_playback_rate);
         }
       }
       phase[slot] = near_fmod(phase[slot] + freq * rate * dt, 1.0f);
@@ -624,7 +632,9 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
         st.waited_s[slot] = 0.0f;
         // A walker who has chosen to stop keeps the cadence to the step the stop begins on
         // (the slowing shortens the steps, as the stop clip then does): the weights hold it.
-        st.min_cadence[slot] = playback_rate[slot];
+        // (Without the reach's quickening: that is for the step in the air, not the cadence.)
+        st.min_cadence[slot] =
+            playback_rate[slot] / (st.rate_boost.empty() ? 1.0f : st.rate_boost[slot]);
         st.chosen_speed_m_s[slot] = v;
         t = k_entry;
         w = 0.0f;

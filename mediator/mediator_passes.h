@@ -185,9 +185,10 @@ void weights_pass(const PassCrowd& crowd, std::span<const float> speed_m_s,
 // clip's clock, the share of gait clips and the travel direction the played clips imply [rad].
 // An agent setting off from standing (no gait clip in last frame's blend, no transition playing:
 // `transition_weight` is last frame's) starts its gait phase where a foot leaves the ground.
-// In APM the rate is raised (within the limits) while the body would otherwise leave the reach of
-// the foot that carries it alone before the other foot lands: a walker speeding up, or one the
-// simulator pushes on, takes quicker steps (reach_boost in mediator_passes.cc).
+// In APM (quicken_steps) the rate is raised (within the limits) while the body would otherwise
+// leave the reach of the foot that carries it alone before the other foot lands: a walker
+// speeding up, or one the simulator pushes on, takes quicker steps (reach_boost in
+// mediator_passes.cc). Not on an agent's first frame, nor while a start or stop plays.
 //
 // Where the drawn root is (root pass, this frame) and goes (the filtered velocity) against the
 // reach of a foot that carries the body alone (last frame's pose, PoseSynthesizer::support_reach;
@@ -199,8 +200,9 @@ struct ReachInput {
   std::span<const glm::vec2> velocity;
   std::span<float> boost;
 };
-// The reach factor eases in and out over this time [s] (a quarter of a walking swing): the
-// cadence rises within the step that needs it, with no jump in every joint's speed.
+// The reach factor goes from 1 to the fastest rate (or back) over this time [s] at the most, at an
+// even pace (a quarter of a walking swing): the cadence rises within the step that needs it, with
+// no jump in every joint's speed.
 inline constexpr float kReachBoostTime = 0.1f;
 void rate_phase_pass(const PassCrowd& crowd, std::span<const int16_t> layer_clip,
                      std::span<const float> layer_weight, std::span<const float> speed_m_s,
@@ -238,6 +240,7 @@ struct TransitionState {
   std::span<float> prev_speed_m_s, prev_phase;
   std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
   std::span<uint32_t> counts;          // [slot * kNumCounts + TransitionCount], cumulative
+  std::span<const float> rate_boost = {};  // the rate pass's reach factor (ReachInput; empty: 1)
 };
 // The agent has stood (or moved) at least this long before a start (stop) counts.
 inline constexpr float kTransitionSettle = 0.25f;  // [s]

@@ -690,6 +690,7 @@ void PoseSynthesizer::pose_coarse(const AnimationPlans& pl, const MediatorParams
   glm::mat4 root = root_placement(pl.root_xz[slot], pl.lower_yaw[slot]);
   placed_xz_[slot] = pl.root_xz[slot];
   root_offset_[slot] = glm::vec2(0.0f);
+  support_reach_[slot] = SupportReach{};  // no foot locks at this detail
   const bool apm = P.mode == MediatorMode::kApm;
   if (apm && P.foot_locking) root[3].y += library_.ground_lift_m;  // flat feet on the floor
   glm::mat4* world = world_of(slot, s);

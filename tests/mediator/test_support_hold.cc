@@ -310,8 +310,8 @@ struct RatePass {
 TEST(ReachBoost, StepsQuickenWhileTheBodyWouldLeaveTheReachBeforeTheLanding) {
   RatePass a;
   const float first = a.step();
-  // Eased in: up by a frame's share of kReachBoostTime, not at once.
-  EXPECT_NEAR(first, 1.0f + kDt / kReachBoostTime, 1e-4f);
+  // Eased in: from 1 toward the fastest rate by a frame's share of kReachBoostTime, not at once.
+  EXPECT_NEAR(first, 1.0f + (a.params.max_playback_rate - 1.0f) * kDt / kReachBoostTime, 1e-4f);
   float r = first;
   for (int f = 0; f < 10; ++f) {
     const float next = a.step();
@@ -319,10 +319,10 @@ TEST(ReachBoost, StepsQuickenWhileTheBodyWouldLeaveTheReachBeforeTheLanding) {
     r = next;
   }
   EXPECT_NEAR(r, a.params.max_playback_rate, 1e-4f);  // asked for 0.3 s / one frame: the limit
-  // The other foot lands in time (the body 0.3 m inside the reach, 0.25 s at 1.2 m/s, landing in
-  // 0.2 s at the quickened rate, 0.27 s at the plain one): back to the plain rate, eased out.
+  // The other foot lands in time (the body 0.3 m inside the reach, 0.25 s at 1.2 m/s; the landing
+  // 0.15 s away at the rate played, 0.2 s at the plain one): back to the plain rate, eased out.
   a.reach[0].radius = 0.78f;
-  a.reach[0].landing_s = 0.2f;
+  a.reach[0].landing_s = 0.15f;
   const float easing = a.step();
   EXPECT_LT(easing, r);
   EXPECT_GT(easing, 1.0f);
@@ -330,7 +330,7 @@ TEST(ReachBoost, StepsQuickenWhileTheBodyWouldLeaveTheReachBeforeTheLanding) {
   EXPECT_NEAR(r, 1.0f, 1e-4f);
 }
 
-TEST(ReachBoost, NotForAReplantingStepNorWithoutASingleSupport) {
+TEST(ReachBoost, NotForAReplantingStepNorANewAgentNorATransition) {
   {
     RatePass a;
     a.reach[0].replanting = true;
@@ -348,8 +348,14 @@ TEST(ReachBoost, NotForAReplantingStepNorWithoutASingleSupport) {
   }
   {
     RatePass a;
-    a.params.mode = MediatorMode::kNaive;  // naive plays the clips as they are
+    a.fresh[0] = 1;  // a new agent: the slot's reach is its previous agent's
     for (int f = 0; f < 5; ++f) EXPECT_NEAR(a.step(), 1.0f, 1e-4f);
+  }
+  {
+    RatePass a;
+    a.transition_weight[0] = 0.5f;  // a start or stop plays: its own clock lands the feet
+    for (int f = 0; f < 5; ++f) EXPECT_NEAR(a.step(), 1.0f, 1e-4f);
+    EXPECT_EQ(a.boost[0], 1.0f);
   }
 }
 
