@@ -465,7 +465,7 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       } else if (native > 1e-3f) {
         rate = std::clamp(speed_m_s[slot] / native * cadence_scale[slot], P.min_playback_rate,
                           P.max_playback_rate);
-        if (P.quicken_steps && !c.fresh[slot] && !(transition_weight[slot] > 0.0f)) {
+        if (P.quicken_steps && is_apm(c) && !c.fresh[slot] && !(transition_weight[slot] > 0.0f)) {
           const float played = out_playback_rate[slot];  // last frame's, overwritten below
           rate = std::clamp(rate * reach_boost(c, reach, slot, rate, played, dt),
                             P.min_playback_rate, P.max_playback_rate);
