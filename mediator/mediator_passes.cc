@@ -453,19 +453,18 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       }
       if (best >= 0.0f) phase[slot] = best;
     }
-    // Not for a new agent (its slot's reach is the previous agent's), without gait clips, outside
-    // APM, nor while a start or stop plays (its own clock lands the feet).
-    if (c.fresh[slot] || !(gait_w > 0.0f) || !is_apm(c) || !P.quicken_steps ||
-        transition_weight[slot] > 0.0f) {
-      reach.boost[slot] = 1.0f;
-    }
+    // Quicker steps: in APM, not for a new agent (its slot's reach is the previous agent's), nor
+    // while a start or stop plays (its own clock lands the feet); the factor is 1 otherwise.
+    const bool quicken = P.quicken_steps && is_apm(c) && !c.fresh[slot] &&
+                         !(transition_weight[slot] > 0.0f) && gait_w > 0.0f;
+    if (!quicken) reach.boost[slot] = 1.0f;
     if (gait_w > 0.0f) {
       if (P.mode == MediatorMode::kNaive) {
         rate = 1.0f;
       } else if (native > 1e-3f) {
         rate = std::clamp(speed_m_s[slot] / native * cadence_scale[slot], P.min_playback_rate,
                           P.max_playback_rate);
-        if (P.quicken_steps && is_apm(c) && !c.fresh[slot] && !(transition_weight[slot] > 0.0f)) {
+        if (quicken) {
           const float played = out_playback_rate[slot];  // last frame's, overwritten below
           rate = std::clamp(rate * reach_boost(c, reach, slot, rate, played, dt),
                             P.min_playback_rate, P.max_playback_rate);
