@@ -27,6 +27,7 @@ constexpr Label kLabels[] = {
     {"idle_step_time_s", "Re-planting step time"},
     {"support_hold", "Hold body at support foot"},
     {"quicken_steps", "Quicken steps at reach"},
+    {"stand_through_jitter", "Stand through jitter"},
     {"feedback", "Feedback to simulator"},
     {"turn_feedback_deg", "Max path-to-legs angle"},
     {"max_accel_m_s2", "Max speed-up"},

@@ -66,6 +66,9 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   fed_speed_.assign(capacity, 0.0f);
   theta_.assign(capacity, 0.0f);
   theta_rate_.assign(capacity, 0.0f);
+  still_at_.assign(capacity, glm::vec2(0.0f));
+  still_jitter2_.assign(capacity, 0.0f);
+  jitter_held_.assign(capacity, 0);
   root_heading_.assign(capacity, 0.0f);
   lower_target_.assign(capacity, 0.0f);
   rel_dir_.assign(capacity, 0.0f);
@@ -248,12 +251,17 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                         pl.fresh,
                         lod ? std::span<const uint8_t>(lod_plan_) : std::span<const uint8_t>(),
                         lod ? std::span<const float>(lod_dt_s_) : std::span<const float>()};
-  filter_pass(crowd, frame, pl.root_xz, {vel_, vel_rate_, theta_, theta_rate_},
-              {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
   const bool honoured = params_.feedback && policy == FeedbackPolicy::kHonoured;
+  // A recording's p jitters with its tracker's noise; a simulator's is where its agent is (its
+  // jitter is answered with feedback).
+  const bool stand_through_jitter =
+      params_.stand_through_jitter && policy == FeedbackPolicy::kIgnored;
+  filter_pass(crowd, frame, pl.root_xz,
+              {vel_, vel_rate_, theta_, theta_rate_, still_at_, still_jitter2_, jitter_held_},
+              stand_through_jitter, {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
   root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_,
             support_hold_allowed_ ? support_reach_ : std::span<const SupportReach>(), honoured,
-            root_speed_, hold_, hold_scale_);
+            root_speed_, hold_, hold_scale_, still_at_, jitter_held_);
   facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw, pl.upper_yaw,
               rel_dir_, pl.layer_clip, pl.layer_weight);
   weights_pass(crowd, pl.speed_m_s, rel_dir_, tr_min_cadence_, {clip_weights_, scratch_target_},

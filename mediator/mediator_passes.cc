@@ -128,14 +128,16 @@ void choose_clip_weights(const LocomotionLibrary& lib, const MediatorParams& par
 }
 
 void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const glm::vec2> root_xz,
-                 FilterState st, SanitisedInput out, std::span<float> out_speed,
-                 std::span<uint8_t> out_standing) {
+                 FilterState st, bool stand_through_jitter, SanitisedInput out,
+                 std::span<float> out_speed, std::span<uint8_t> out_standing) {
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);
   // Without a level of detail every agent steps by dt_s: the springs' decays once for all.
   const bool one_step = c.step_s.empty();
   const SpringStep vel_step = spring_step(P.velocity_halflife_s, c.dt_s);
   const SpringStep theta_step = spring_step(P.theta_halflife_s, c.dt_s);
+  const bool jitter_gate = apm && stand_through_jitter;
+  const float still_a = 1.0f - std::exp(-c.dt_s / kStillAverageTime);
   for_each_agent(c, [&](size_t i, int slot) {
     const float dt = c.dt(slot);
     // Sanitise what the simulator gave (NaN, absurd speeds): hold the last good values.
@@ -159,9 +161,41 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
       st.vel[slot] = v;
       st.theta[slot] = theta_raw;
     }
-    const float speed = glm::length(st.vel[slot]);
+    float speed = glm::length(st.vel[slot]);
+    bool stand = speed < P.stop_speed_m_s;
+    uint8_t held = 0;
+    if (jitter_gate) {
+      glm::vec2& at = st.still_at[slot];
+      float& jitter2 = st.still_jitter2[slot];
+      const bool stood = !c.fresh[slot] && out_standing[slot] != 0;
+      const float a = one_step ? still_a : 1.0f - std::exp(-dt / kStillAverageTime);
+      if (c.fresh[slot]) {
+        at = p;
+        jitter2 = 0.0f;
+      } else {
+        // How far p strays: standing, from where it stands; walking, from the smooth path the
+        // drawn root takes (last frame's root).
+        const glm::vec2 d = p - (stood ? at : root_xz[slot]);
+        jitter2 += (glm::dot(d, d) - jitter2) * a;
+      }
+      if (stood && !stand) {
+        const glm::vec2 off = p - at;
+        const float r = kStartJitterSigmas * std::sqrt(jitter2);
+        if (glm::dot(off, off) < r * r) {
+          stand = true;  // it stays where it stands: jitter, not a start
+          speed = 0.0f;
+          held = 1;
+        }
+      }
+      if (stand && !stood) {
+        at = p;
+      } else if (stand) {
+        at += (p - at) * a;
+      }
+    }
+    if (!st.jitter_held.empty()) st.jitter_held[slot] = held;
     out_speed[slot] = speed;
-    out_standing[slot] = speed < P.stop_speed_m_s;
+    out_standing[slot] = stand;
   });
 }
 
@@ -170,7 +204,8 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
                std::span<const float> lower_yaw, std::span<glm::vec2> root_xz,
                std::span<float> out_root_heading, std::span<const SupportReach> support_reach,
                bool honoured, std::span<float> root_speed, std::span<glm::vec2> out_hold,
-               std::span<float> out_hold_scale) {
+               std::span<float> out_hold_scale, std::span<const glm::vec2> still_at,
+               std::span<const uint8_t> jitter_held) {
   const bool apm = is_apm(c);
   const bool one_step = c.step_s.empty();  // every agent steps by dt_s: one exp for all
   const float pull = root_pull(c.dt_s);
@@ -186,7 +221,12 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
     out_hold[slot] = glm::vec2(0.0f);
     out_hold_scale[slot] = 1.0f;
     if (apm && !c.fresh[slot]) {
-      glm::vec2 root = pulled_root(root_xz[slot], vel, p, dt, one_step ? pull : root_pull(dt));
+      const bool held = !jitter_held.empty() && jitter_held[slot];
+      glm::vec2 root =
+          held ? near_p(pulled_root(root_xz[slot], glm::vec2(0.0f), still_at[slot], dt,
+                                    one_step ? pull : root_pull(dt)),
+                        p)
+               : pulled_root(root_xz[slot], vel, p, dt, one_step ? pull : root_pull(dt));
       // A foot that carries the body alone holds it back (a source that takes feedback only:
       // one that does not would just be caught up with later). Until the other foot comes down
       // the root may cover what is left of the support leg's reach, no more: its speed away from

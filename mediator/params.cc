@@ -58,6 +58,10 @@ constexpr ParamInfo kInfos[] = {
      "step faster (within the rate limits) while the body would leave the reach of a foot that "
      "carries it alone before the other foot lands",
      0.0f, 1.0f, K::kBool, nullptr, &P::quicken_steps},
+    {"stand_through_jitter", "on/off",
+     "recordings (no feedback): a standing agent walks only once p leaves where it stands by "
+     "more than 3 times its jitter",
+     0.0f, 1.0f, K::kBool, nullptr, &P::stand_through_jitter},
     {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator",
      0.0f, 1.0f, K::kBool, nullptr, &P::feedback},
     {"turn_feedback_deg", "deg",

@@ -51,6 +51,10 @@ struct MediatorParams {
   // reach of the foot that carries it alone before the other foot lands (rate_phase_pass): the
   // swing ends sooner, rather than the support foot being overstretched and let go.
   bool quicken_steps = true;
+  // A source that takes no feedback (a recording): a standing agent starts walking only once its
+  // p leaves where it stands by more than three times its jitter (tracker noise), instead of
+  // walking and turning after every wobble (filter_pass).
+  bool stand_through_jitter = true;
   // 8. Feedback to the simulator.
   bool feedback = true;
   float turn_feedback_deg = 10.0f;  // [deg] [Limit: 0..180] forward-only libraries: velocity kept

@@ -120,6 +120,54 @@ TEST(Mediator, SettingOffFromStandingNeverLiftsBothFeet) {
   EXPECT_GT(steps, 0) << "no agent re-planted a foot: the test saw nothing";
 }
 
+// stand_through_jitter holds a standing agent of a recording while its p moves within its
+// jitter; a clean track's jitter is about nil, so its starts are not delayed: a pedestrian who sets
+// off (smoothly, from rest, no feedback taken) is walking on the same frame with it as without.
+// One whose p wobbles about where it stands (3 cm every 0.4 s, at up to 0.3 m/s) stays standing
+// with it, and without it is taken to walk.
+TEST(Mediator, StandingThroughJitterDoesNotDelayACleanStart) {
+  constexpr float kDt = 1.0f / 60.0f;
+  auto first_walking_frame = [&](bool gate, std::function<glm::vec2(double)> vel, int* walking) {
+    std::vector<Script> s{{{0.0f, 0.0f}, std::move(vel), [](double, glm::vec2) { return 0.0f; }}};
+    test::ScriptedCrowd crowd(std::move(s));
+    MediatorParams p;
+    p.stand_through_jitter = gate;
+    CrowdPipeline pipeline(builtin_library(), p, test::test_pipeline_options(1, kDt));
+    int first = -1;
+    *walking = 0;
+    for (int f = 0; f < 300; ++f) {
+      EXPECT_TRUE(pipeline.step(crowd, kDt).ok());
+      const AnimationPlans& pl = pipeline.mediator().plans();
+      const bool walks = pl.standing[static_cast<size_t>(pl.slot_of_agent[0])] == 0;
+      if (walks && first < 0 && f > 0) first = f;
+      if (f >= 150) *walking += walks;  // after the first few wobbles
+    }
+    return first;
+  };
+  auto start = [](double t) {
+    const double u = std::clamp((t - 2.0) / 1.0, 0.0, 1.0);
+    return glm::vec2(0.0f, static_cast<float>(1.3 * u * u * (3.0 - 2.0 * u)));
+  };
+  int walking_on = 0, walking_off = 0;
+  const int on = first_walking_frame(true, start, &walking_on);
+  const int off = first_walking_frame(false, start, &walking_off);
+  EXPECT_GT(off, 100) << "it stood for two seconds first";
+  EXPECT_EQ(on, off);
+  // A wobble: 3 cm out and back in 0.8 s (at up to 0.12 m/s), each time in another direction.
+  auto wobble = [](double t) {
+    const int k = static_cast<int>(t / 0.4);
+    const float dir = 2.4f * static_cast<float>(k / 2);
+    const float peak = 0.03f * std::numbers::pi_v<float> / (2.0f * 0.4f);
+    const float speed = (k % 2 == 0 ? peak : -peak) *
+                        static_cast<float>(std::sin(std::numbers::pi * (t / 0.4 - k)));
+    return speed * glm::vec2(std::sin(dir), std::cos(dir));
+  };
+  first_walking_frame(true, wobble, &walking_on);
+  first_walking_frame(false, wobble, &walking_off);
+  EXPECT_EQ(walking_on, 0) << "held standing once it has shown its jitter";
+  EXPECT_GT(walking_off, 30) << "without, it walks on many of those frames";
+}
+
 TEST(Mediator, TorsionNeverExceedsTheLimit) {
   // theta sweeps all the way round while walking: the twist must clamp at the limit.
   MediatorParams p;
