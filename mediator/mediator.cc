@@ -111,6 +111,7 @@ void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::v
   fed_speed_[slot] = glm::length(vel);
   theta_[slot] = th;
   theta_rate_[slot] = 0.0f;
+  jitter_held_[slot] = 0;
   const float speed = glm::length(vel);
   const float yaw = speed > params_.stop_speed_m_s ? heading2(vel) : th;
   plans_.lower_yaw[slot] = yaw;
@@ -319,9 +320,15 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
   feedback_.positions[agent] = p;
   feedback_.velocities[agent] = v;
   feedback_.thetas[agent] = std::isfinite(theta_in) ? theta_in : theta_[slot];
-  pl.root_xz[slot] = params_.mode == MediatorMode::kApm
-                         ? pulled_root(pl.root_xz[slot], vel_[slot], p, dt, pull)
-                         : p;
+  // As the root pass draws it: an agent held standing through its jitter where it stands.
+  if (params_.mode != MediatorMode::kApm) {
+    pl.root_xz[slot] = p;
+  } else if (jitter_held_[slot]) {
+    pl.root_xz[slot] =
+        near_p(pulled_root(pl.root_xz[slot], glm::vec2(0.0f), still_at_[slot], dt, pull), p);
+  } else {
+    pl.root_xz[slot] = pulled_root(pl.root_xz[slot], vel_[slot], p, dt, pull);
+  }
   // The gait frequency of the planned blend, as the rate and phase pass takes it (kept from the
   // agent's last plan: its layers and weights have not changed since).
   const int16_t* lc = &pl.layer_clip[slot * kMaxBlendLayers];
