@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The quality matrix of the mediator: every built-in scenario on both simulators and every
+# The quality matrix of the mediator: every built-in scenario (data/scenarios) on both simulators and every
 # trajectory file in the shared data (the Social-GAN .txt files and ETH's original obsmat.txt), with the built-in clips, the mannequin glTF clips, the two
 # CMU clips and the CMU subject-16 set (clips/bvh/more), in naive and apm modes, 60 Hz, 600 frames,
 # with the METRICS.md v1 and v2 columns (v2 floors of the library's own clips in brackets). Writes a Markdown table (stdout, and
@@ -32,7 +32,13 @@ declare -A clipsets=(
   [more]="--clips $data/clips/bvh/more"
 )
 runs=()
-for sc in corridor crossing circle bottleneck plaza gallery; do
+# Every built-in scenario (data/scenarios/*.json), the six of the demo first.
+scenarios=(corridor crossing circle bottleneck plaza gallery)
+for f in data/scenarios/*.json; do
+  sc=$(basename "$f" .json)
+  [[ " ${scenarios[*]} " == *" $sc "* ]] || scenarios+=("$sc")
+done
+for sc in "${scenarios[@]}"; do
   for sim in social detour; do runs+=("$sc|--scenario $sc --sim $sim $agents|$sim"); done
 done
 for f in "$data"/trajectories/*/*.txt; do
