@@ -124,7 +124,8 @@ class Mediator {
   std::vector<float> theta_, theta_rate_;  // theta spring (unwrapped)
   std::vector<glm::vec2> still_at_;        // where a standing agent stands (FilterState)
   std::vector<float> still_jitter2_;       // its p's mean square jitter there [m^2]
-  std::vector<uint8_t> jitter_held_;       // scratch: held standing through that jitter
+  std::vector<uint8_t> jitter_held_;       // held standing through it at the last plan (LOD
+                                           // advance_agent reads it between plans)
   bool library_doubtful_ = false;          // gait_analysis_doubtful(library_), found once
   bool degraded_ = false;                  // apm asked, naive played (a doubtful library)
   std::vector<float> fed_speed_;           // the speed the simulator was last given [m/s]

@@ -138,6 +138,7 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
   const SpringStep theta_step = spring_step(P.theta_halflife_s, c.dt_s);
   const bool jitter_gate = apm && stand_through_jitter;
   const float still_a = 1.0f - std::exp(-c.dt_s / kStillAverageTime);
+  const float reach = P.idle_step_distance_m;
   for_each_agent(c, [&](size_t i, int slot) {
     const float dt = c.dt(slot);
     // Sanitise what the simulator gave (NaN, absurd speeds): hold the last good values.
@@ -164,34 +165,40 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
     float speed = glm::length(st.vel[slot]);
     bool stand = speed < P.stop_speed_m_s;
     uint8_t held = 0;
-    if (jitter_gate) {
+    if (jitter_gate && usable_position(p_in)) {
       glm::vec2& at = st.still_at[slot];
       float& jitter2 = st.still_jitter2[slot];
-      const bool stood = !c.fresh[slot] && out_standing[slot] != 0;
-      const float a = one_step ? still_a : 1.0f - std::exp(-dt / kStillAverageTime);
-      if (c.fresh[slot]) {
+      if (c.fresh[slot] || jitter2 < 0.0f) {  // new, or the gate was off: nothing known yet
         at = p;
         jitter2 = 0.0f;
-      } else {
-        // How far p strays: standing, from where it stands; walking, from the smooth path the
-        // drawn root takes (last frame's root).
-        const glm::vec2 d = p - (stood ? at : root_xz[slot]);
-        jitter2 += (glm::dot(d, d) - jitter2) * a;
       }
-      if (stood && !stand) {
+      const bool stood = !c.fresh[slot] && out_standing[slot] != 0;
+      const float a = one_step ? still_a : 1.0f - std::exp(-dt / kStillAverageTime);
+      if (stood) {
         const glm::vec2 off = p - at;
-        const float r = kStartJitterSigmas * std::sqrt(jitter2);
-        if (glm::dot(off, off) < r * r) {
+        const float d2 = glm::dot(off, off);
+        // Held no further than a standing body's feet reach without a step (idle_step_distance_m):
+        // a start is let go by then at the latest, whatever the jitter seen.
+        const float r = std::min(kStartJitterSigmas * std::sqrt(jitter2), reach);
+        if (!stand && d2 < r * r) {
           stand = true;  // it stays where it stands: jitter, not a start
           speed = 0.0f;
           held = 1;
         }
+        // The jitter about where it stands, over every frame it stands; a frame adds no more
+        // than the reach, so a start it holds cannot raise the limit past it.
+        jitter2 += (std::min(d2, reach * reach) - jitter2) * a;
       }
       if (stand && !stood) {
-        at = p;
-      } else if (stand) {
-        at += (p - at) * a;
+        // Stopped somewhere new: it stands here. Back where it stood before (a wobble let go as a
+        // start that went nowhere), that place stays, its average kept.
+        const glm::vec2 off = p - at;
+        if (glm::dot(off, off) > reach * reach) at = p;
+      } else if (stand && !held) {
+        at += (p - at) * a;  // where it stands moves with a slow p, not with a held one
       }
+    } else if (!st.still_jitter2.empty()) {
+      st.still_jitter2[slot] = -1.0f;  // unknown when the gate is next on
     }
     if (!st.jitter_held.empty()) st.jitter_held[slot] = held;
     out_speed[slot] = speed;

@@ -122,18 +122,21 @@ void choose_clip_weights(const LocomotionLibrary& library, const MediatorParams&
 struct FilterState {
   std::span<glm::vec2> vel, vel_rate;  // [m/s], [m/s^2]
   std::span<float> theta, theta_rate;  // unwrapped [rad], [rad/s]
-  // APM: where a standing agent stands (p averaged over kStillAverageTime), the mean square of
-  // p's distance from the drawn root over the same time (its jitter about the smooth path the
-  // root takes) [m^2], and (out) whether it stands only because p moved within that jitter.
+  // With the gate (filter_pass): where a standing agent stands (p averaged over
+  // kStillAverageTime while it stands with a slow p; kept while it is held), the mean square of
+  // p's distance from there over its standing frames (each at most the hold's reach) [m^2]
+  // (-1: unknown, the gate was off), and (out) whether it stands this frame only because p moved
+  // within that jitter.
   std::span<glm::vec2> still_at;
   std::span<float> still_jitter2;
   std::span<uint8_t> jitter_held;
 };
 // A tracker's noise moves a standing pedestrian's recorded p back and forth at walking-like
 // speeds (2 cm of noise every 0.4 s: about 0.1 m/s, in a new direction each sample), but never
-// away: such an agent starts walking only once p has left where it stands by more than
-// kStartJitterSigmas times the root-mean-square of its jitter (a clean track's is about 0: its
-// starts are not delayed). Averages over kStillAverageTime [s].
+// away: such an agent stays standing while p is within kStartJitterSigmas times the
+// root-mean-square of its jitter of where it stands, and never further than a re-planting step
+// (MediatorParams::idle_step_distance_m: a standing body's feet take up that much). A clean
+// track's jitter is about nil: its starts are not delayed. Averages over kStillAverageTime [s].
 inline constexpr float kStartJitterSigmas = 3.0f;
 inline constexpr float kStillAverageTime = 1.0f;
 // Per agent: the frame's values with unusable ones replaced by the agent's last good ones.
@@ -145,8 +148,9 @@ struct SanitisedInput {
 // Reads the frame, last frame's filter state, `standing` and drawn root (a bad p holds it).
 // Writes the sanitised input (per agent), the filter state, the filtered speed and `standing`.
 // With stand_through_jitter (APM, MediatorParams::stand_through_jitter, a source that takes no
-// feedback), a standing agent whose p moves about where it stands by no more than
-// kStartJitterSigmas times its jitter stays standing (speed 0, FilterState::jitter_held).
+// feedback), a standing agent whose p is within its jitter's reach of where it stands stays
+// standing (speed 0, FilterState::jitter_held; kStartJitterSigmas). A frame whose p is unusable
+// leaves that state as it was.
 void filter_pass(const PassCrowd& crowd, const AgentFrame& frame,
                  std::span<const glm::vec2> root_xz, FilterState state, bool stand_through_jitter,
                  SanitisedInput out, std::span<float> out_speed_m_s,
@@ -160,8 +164,9 @@ void filter_pass(const PassCrowd& crowd, const AgentFrame& frame,
 // carries the body alone) and its heading, the direction it travels [rad] (the lower body's yaw
 // when standing), per slot its speed (root_speed: last frame's in, this frame's out) [m/s], and
 // the hold: how far the root was held back [m] and the share of its step it kept (both fed
-// back). An agent held standing through its p's jitter (FilterState::jitter_held, per slot;
-// empty: none) is drawn where it stands (FilterState::still_at), within kMaxRootOffset of p.
+// back). On a frame an agent is held standing through its p's jitter (FilterState::jitter_held,
+// per slot; empty: none), its root is pulled toward where it stands (FilterState::still_at)
+// instead of p, within kMaxRootOffset of p; on its other standing frames, toward p as always.
 void root_pass(const PassCrowd& crowd, std::span<const glm::vec2> positions,
                std::span<const glm::vec2> vel, std::span<const uint8_t> standing,
                std::span<const float> lower_yaw, std::span<glm::vec2> root_xz,

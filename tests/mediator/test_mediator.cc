@@ -1,9 +1,11 @@
 // The mediator on scripted crowds with the built-in clips: planted feet, rate limits, torsion
 // limit, facing, feedback and robustness, each measured with the METRICS.md definitions.
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -120,52 +122,138 @@ TEST(Mediator, SettingOffFromStandingNeverLiftsBothFeet) {
   EXPECT_GT(steps, 0) << "no agent re-planted a foot: the test saw nothing";
 }
 
-// stand_through_jitter holds a standing agent of a recording while its p moves within its
-// jitter; a clean track's jitter is about nil, so its starts are not delayed: a pedestrian who sets
-// off (smoothly, from rest, no feedback taken) is walking on the same frame with it as without.
-// One whose p wobbles about where it stands (3 cm every 0.4 s, at up to 0.3 m/s) stays standing
-// with it, and without it is taken to walk.
-TEST(Mediator, StandingThroughJitterDoesNotDelayACleanStart) {
-  constexpr float kDt = 1.0f / 60.0f;
-  auto first_walking_frame = [&](bool gate, std::function<glm::vec2(double)> vel, int* walking) {
-    std::vector<Script> s{{{0.0f, 0.0f}, std::move(vel), [](double, glm::vec2) { return 0.0f; }}};
-    test::ScriptedCrowd crowd(std::move(s));
-    MediatorParams p;
-    p.stand_through_jitter = gate;
-    CrowdPipeline pipeline(builtin_library(), p, test::test_pipeline_options(1, kDt));
-    int first = -1;
-    *walking = 0;
-    for (int f = 0; f < 300; ++f) {
-      EXPECT_TRUE(pipeline.step(crowd, kDt).ok());
-      const AnimationPlans& pl = pipeline.mediator().plans();
-      const bool walks = pl.standing[static_cast<size_t>(pl.slot_of_agent[0])] == 0;
-      if (walks && first < 0 && f > 0) first = f;
-      if (f >= 150) *walking += walks;  // after the first few wobbles
+// stand_through_jitter (a source that takes no feedback): one agent's standing flag and p per
+// frame, with the gate on or off, at frame time dt, optionally far from the LOD focus (planned
+// every 8th frame) and with a hook before each step.
+struct StandingRun {
+  std::vector<uint8_t> walking;
+  std::vector<glm::vec2> p;
+};
+StandingRun run_standing(bool gate, float dt, std::function<glm::vec2(double)> vel, double t_end,
+                         bool lod_far = false,
+                         std::function<void(CrowdPipeline&, int)> hook = nullptr) {
+  std::vector<Script> s{{{2.0f, 1.0f}, std::move(vel), [](double, glm::vec2) { return 0.0f; }}};
+  test::ScriptedCrowd crowd(std::move(s));
+  MediatorParams p;
+  p.stand_through_jitter = gate;
+  CrowdPipeline pipeline(builtin_library(), p, test::test_pipeline_options(1, dt));
+  if (lod_far) {
+    LodParams lp;
+    lp.enabled = true;
+    lp.focus = glm::vec2(1000.0f, 1000.0f);
+    EXPECT_TRUE(pipeline.set_lod(lp).ok());
+  }
+  StandingRun out;
+  const int frames = static_cast<int>(std::lround(t_end / dt));
+  for (int f = 0; f < frames; ++f) {
+    if (hook) hook(pipeline, f);
+    EXPECT_TRUE(pipeline.step(crowd, dt).ok());
+    const AnimationPlans& pl = pipeline.plans();
+    out.walking.push_back(pl.standing[static_cast<size_t>(pl.slot_of_agent[0])] == 0);
+    out.p.push_back(pipeline.frame().positions[0]);
+  }
+  return out;
+}
+// The first frame from `from` on where the agent walks (-1: never).
+int first_walking(const StandingRun& r, int from) {
+  for (size_t f = static_cast<size_t>(from); f < r.walking.size(); ++f) {
+    if (r.walking[f]) return static_cast<int>(f);
+  }
+  return -1;
+}
+double ease(double u) {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * (3.0 - 2.0 * u);
+}
+// A wobble: 3 cm out and back in 0.8 s (at up to 0.12 m/s), each time in another direction.
+glm::vec2 wobble(double t) {
+  const int k = static_cast<int>(t / 0.4);
+  const float dir = 2.4f * static_cast<float>(k / 2);
+  const float peak = 0.03f * std::numbers::pi_v<float> / (2.0f * 0.4f);
+  const float speed =
+      (k % 2 == 0 ? peak : -peak) * static_cast<float>(std::sin(std::numbers::pi * (t / 0.4 - k)));
+  return speed * glm::vec2(std::sin(dir), std::cos(dir));
+}
+
+// A clean track's jitter is about nil: a walker who stops, waits and sets off again is walking on
+// the same frame with the gate as without, at 60 and 30 fps, and planned every 8th frame (LOD).
+TEST(Mediator, StandingThroughJitterKeepsCleanStartsOnTime) {
+  for (const float dt : {1.0f / 60.0f, 1.0f / 30.0f}) {
+    for (const double pause : {0.3, 1.0, 2.0}) {
+      for (const bool lod : {false, true}) {
+        auto vel = [pause](double t) {
+          double v = 1.3;
+          if (t >= 2.0 && t < 3.0) v = 1.3 * (1.0 - ease(t - 2.0));
+          if (t >= 3.0) v = t < 3.0 + pause ? 0.0 : 1.3 * ease(t - 3.0 - pause);
+          return glm::vec2(0.0f, static_cast<float>(v));
+        };
+        const int restart = static_cast<int>(std::lround((3.0 + pause) / dt));
+        const StandingRun on = run_standing(true, dt, vel, 3.0 + pause + 3.0, lod);
+        const StandingRun off = run_standing(false, dt, vel, 3.0 + pause + 3.0, lod);
+        const std::string what =
+            "dt " + std::to_string(dt) + " pause " + std::to_string(pause) + (lod ? " lod" : "");
+        ASSERT_GE(first_walking(off, restart), restart) << what;
+        EXPECT_EQ(first_walking(on, restart), first_walking(off, restart)) << what;
+      }
     }
-    return first;
-  };
-  auto start = [](double t) {
-    const double u = std::clamp((t - 2.0) / 1.0, 0.0, 1.0);
-    return glm::vec2(0.0f, static_cast<float>(1.3 * u * u * (3.0 - 2.0 * u)));
-  };
+  }
+  // A new agent standing still starts on time too.
+  auto start = [](double t) { return glm::vec2(0.0f, static_cast<float>(1.3 * ease(t - 2.0))); };
+  const StandingRun on = run_standing(true, 1.0f / 60.0f, start, 5.0);
+  const StandingRun off = run_standing(false, 1.0f / 60.0f, start, 5.0);
+  EXPECT_GT(first_walking(off, 1), 100) << "it stood for two seconds first";
+  EXPECT_EQ(first_walking(on, 1), first_walking(off, 1));
+}
+
+// One whose p wobbles about where it stands stays standing once it has shown its jitter (without
+// the gate it walks on many frames); when it then walks off slowly (0.3 m/s, still wobbling) it is
+// let go within a second, before p has left where it stood by more than a re-planting step.
+TEST(Mediator, StandingThroughJitterHoldsAWobbleAndLetsASlowStartGo) {
+  constexpr float kDt = 1.0f / 60.0f;
+  const StandingRun on = run_standing(true, kDt, wobble, 5.0);
+  const StandingRun off = run_standing(false, kDt, wobble, 5.0);
   int walking_on = 0, walking_off = 0;
-  const int on = first_walking_frame(true, start, &walking_on);
-  const int off = first_walking_frame(false, start, &walking_off);
-  EXPECT_GT(off, 100) << "it stood for two seconds first";
-  EXPECT_EQ(on, off);
-  // A wobble: 3 cm out and back in 0.8 s (at up to 0.12 m/s), each time in another direction.
-  auto wobble = [](double t) {
-    const int k = static_cast<int>(t / 0.4);
-    const float dir = 2.4f * static_cast<float>(k / 2);
-    const float peak = 0.03f * std::numbers::pi_v<float> / (2.0f * 0.4f);
-    const float speed = (k % 2 == 0 ? peak : -peak) *
-                        static_cast<float>(std::sin(std::numbers::pi * (t / 0.4 - k)));
-    return speed * glm::vec2(std::sin(dir), std::cos(dir));
-  };
-  first_walking_frame(true, wobble, &walking_on);
-  first_walking_frame(false, wobble, &walking_off);
+  for (size_t f = 150; f < on.walking.size(); ++f) {  // after the first few wobbles
+    walking_on += on.walking[f];
+    walking_off += off.walking[f];
+  }
   EXPECT_EQ(walking_on, 0) << "held standing once it has shown its jitter";
   EXPECT_GT(walking_off, 30) << "without, it walks on many of those frames";
+
+  auto walk_off = [](double t) {
+    glm::vec2 v = wobble(t);
+    if (t >= 4.0) v.y += static_cast<float>(0.3 * ease((t - 4.0) / 0.5));
+    return v;
+  };
+  const StandingRun slow = run_standing(true, kDt, walk_off, 8.0);
+  const int from = static_cast<int>(4.0 / kDt);
+  const int walks = first_walking(slow, from);
+  ASSERT_GE(walks, from);
+  EXPECT_LT(walks - from, static_cast<int>(1.0 / kDt)) << "let go within a second";
+  const MediatorParams defaults;
+  for (size_t f = static_cast<size_t>(from); f < static_cast<size_t>(walks); ++f) {
+    EXPECT_LE(glm::length(slow.p[f] - slow.p[static_cast<size_t>(from)]),
+              defaults.idle_step_distance_m + 0.03f)
+        << "frame " << f;
+  }
+}
+
+// Switched from naive to APM while it stands (the panel's mode), it knows nothing of where it
+// stood under naive: its start is on time, as when it had been in APM all along.
+TEST(Mediator, StandingThroughJitterStartsAfreshWhenTheGateComesOn) {
+  constexpr float kDt = 1.0f / 60.0f;
+  auto start = [](double t) { return glm::vec2(0.0f, static_cast<float>(1.3 * ease(t - 4.0))); };
+  auto switched = [](CrowdPipeline& pipeline, int f) {
+    if (f != 0 && f != 120) return;
+    MediatorParams p = pipeline.params();
+    p.mode = f == 0 ? MediatorMode::kNaive : MediatorMode::kApm;
+    pipeline.set_params(p);
+  };
+  const StandingRun sw = run_standing(true, kDt, start, 7.0, false, switched);
+  const StandingRun apm = run_standing(true, kDt, start, 7.0);
+  const int from = static_cast<int>(4.0 / kDt);
+  ASSERT_GE(first_walking(apm, from), from);
+  EXPECT_EQ(first_walking(sw, from), first_walking(apm, from));
 }
 
 TEST(Mediator, TorsionNeverExceedsTheLimit) {

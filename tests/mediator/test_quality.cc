@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -296,34 +297,39 @@ TEST(Quality, PedestriansAppearingMidStrideStandOnTheirSupportFoot) {
 
 }  // namespace
 
-// A tracker's noise on recorded pedestrians: ETH's hotel annotations with 2 cm of Gaussian noise
-// added to every sample (0.4 s apart), as a detector's positions have it. Standing people's p then
-// moves at walking-like speeds in a new direction every sample. With stand_through_jitter they
-// stand, and every bound holds as on the clean file; without it the mannequins walked and turned
-// after each wobble (heading error p95 85 degrees against 8, skate 0.0116).
+// ETH's hotel annotations with `sigma` [m] of Gaussian noise added to every sample (0.4 s apart),
+// as a detector's positions have it, in a temporary file (its path returned).
+std::string noisy_copy(const std::string& file, double sigma, const std::string& name) {
+  std::ifstream in(test::data_path(file));
+  EXPECT_TRUE(in.good()) << file;
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream out(path);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, sigma);
+  std::string line;
+  int samples = 0;
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    double frame, id, x, y;
+    if (!(row >> frame >> id >> x >> y)) continue;
+    out << frame << ' ' << id << ' ' << x + noise(rng) << ' ' << y + noise(rng) << '\n';
+    ++samples;
+  }
+  EXPECT_GT(samples, 1000) << file;
+  return path;
+}
+
+// A tracker's noise moves standing people's p at walking-like speeds in a new direction every
+// sample. With stand_through_jitter they stand, and every bound holds as on the clean file;
+// without it the mannequins walked and turned after each wobble (heading error p95 85 degrees
+// against 8, skate 0.0116).
 TEST(Quality, TrackerNoiseDoesNotWalkStandingPedestrians) {
   GK_REQUIRE_DATA("trajectories/hotel/biwi_hotel.txt");
   GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
   auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
   ASSERT_TRUE(lib.ok()) << lib.message();
-  std::ifstream in(test::data_path("trajectories/hotel/biwi_hotel.txt"));
-  ASSERT_TRUE(in.good());
-  const std::string noisy = ::testing::TempDir() + "/gk_hotel_noisy.txt";
-  {
-    std::ofstream out(noisy);
-    std::mt19937 rng(7);
-    std::normal_distribution<double> noise(0.0, 0.02);
-    std::string line;
-    int samples = 0;
-    while (std::getline(in, line)) {
-      std::istringstream row(line);
-      double frame, id, x, y;
-      if (!(row >> frame >> id >> x >> y)) continue;
-      out << frame << ' ' << id << ' ' << x + noise(rng) << ' ' << y + noise(rng) << '\n';
-      ++samples;
-    }
-    ASSERT_GT(samples, 1000);
-  }
+  const std::string noisy =
+      noisy_copy("trajectories/hotel/biwi_hotel.txt", 0.02, "gk_hotel_noisy.txt");
   MediatorParams off;
   off.stand_through_jitter = false;
   auto a = load_trajectory_replay(noisy);
@@ -338,6 +344,51 @@ TEST(Quality, TrackerNoiseDoesNotWalkStandingPedestrians) {
   expect_feet_bounds(apm, naive, "noisy hotel mannequin");
   // Without it the lower body turned after the noise and lagged its direction by far more.
   EXPECT_GT(walked.heading_error_deg.p95, 3.0 * apm.heading_error_deg.p95);
+}
+
+// Held standing only through jitter: over whole recordings (ETH and Zara as annotated, and the
+// hotel with 2 cm of noise), no pedestrian is taken to stand while its p goes more than half a
+// metre from where it stopped (a hold that fed its own threshold once kept walkers standing for
+// metres).
+TEST(Quality, RecordedPedestriansAreNotHeldStandingWhileTheyWalkAway) {
+  GK_REQUIRE_DATA("trajectories/eth/biwi_eth.txt");
+  GK_REQUIRE_DATA("trajectories/zara1/crowds_zara01.txt");
+  GK_REQUIRE_DATA("trajectories/hotel/biwi_hotel.txt");
+  const std::string noisy =
+      noisy_copy("trajectories/hotel/biwi_hotel.txt", 0.02, "gk_hotel_noisy_whole.txt");
+  const std::pair<std::string, float> files[] = {
+      {test::data_path("trajectories/eth/biwi_eth.txt"), 0.667f},
+      {test::data_path("trajectories/zara1/crowds_zara01.txt"), 0.4f},
+      {noisy, 0.4f}};
+  for (const auto& [file, frame_time] : files) {
+    ReplayOptions options;
+    options.frame_time_s = frame_time;
+    auto src = load_trajectory_replay(file, options);
+    ASSERT_TRUE(src.ok()) << src.message();
+    const float dt = 1.0f / 60.0f;
+    CrowdPipeline pipeline(test::builtin_library(), MediatorParams{},
+                           test::test_pipeline_options((*src)->capacity(), dt, false, false));
+    std::map<uint32_t, glm::vec2> stood_at;
+    int held_far = 0, stood = 0;
+    for (int f = 0; f < 60 * 600; ++f) {  // ten minutes: every track of the three files
+      ASSERT_TRUE(pipeline.step(**src, dt).ok());
+      const AgentFrame fr = pipeline.frame();
+      const AnimationPlans& pl = pipeline.plans();
+      for (size_t i = 0; i < fr.size(); ++i) {
+        const uint32_t id = fr.ids[i];
+        if (!pl.standing[static_cast<size_t>(pl.slot_of_agent[i])]) {
+          stood_at.erase(id);
+          continue;
+        }
+        auto [it, fresh] = stood_at.emplace(id, fr.positions[i]);
+        stood += fresh;
+        held_far += glm::length(fr.positions[i] - it->second) > 0.5f;
+      }
+    }
+    EXPECT_GT(stood, 5) << file << ": some pedestrians stood";
+    EXPECT_EQ(held_far, 0) << file;
+  }
+  std::filesystem::remove(noisy);
 }
 
 }  // namespace gk
