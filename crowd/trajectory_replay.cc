@@ -18,6 +18,8 @@ constexpr float kPi = 3.14159265358979f;
 constexpr double kTimeEpsilon_s = 1e-4;
 // Below this speed [m/s] the heading of the velocity is mostly annotation noise: hold theta.
 constexpr float kHeadingMinSpeed_m_s = 0.1f;
+// A heading is taken only from a velocity this many times its noise (heading_speed).
+constexpr float kHeadingNoiseSigmas = 3.0f;
 // Time constant [s] of the exponential smoothing of theta toward the velocity heading. Short: the
 // interpolant is already smooth; this only rounds off the turn-on-the-spot of slow walkers.
 constexpr float kThetaTau_s = 0.15f;
@@ -60,6 +62,30 @@ class TrajectoryReplay final : public CrowdSource {
   size_t capacity() const override { return out_ids_.size(); }
 
  private:
+  // The speed [m/s] above which track [begin, end)'s heading is its walking direction rather than
+  // its samples' jitter: kHeadingMinSpeed_m_s, or three times the velocity noise its positions'
+  // jitter makes (the jitter from the median second difference of evenly spaced samples, as the
+  // clip analysis takes a capture's: 1.1774 * sqrt(6) sigma for white noise of sigma per axis).
+  float heading_speed(uint32_t begin, uint32_t end) const {
+    std::vector<float> d2;
+    std::vector<double> steps;
+    for (uint32_t i = begin + 1; i + 1 < end; ++i) {
+      const double h0 = sample_time_s_[i] - sample_time_s_[i - 1];
+      const double h1 = sample_time_s_[i + 1] - sample_time_s_[i];
+      if (!(h0 > 0.0) || std::abs(h1 - h0) > 1e-3 * h0) continue;  // a gap: not a second difference
+      const glm::vec2 d = sample_pos_[i + 1] - 2.0f * sample_pos_[i] + sample_pos_[i - 1];
+      d2.push_back(glm::length(d));
+      steps.push_back(h0);
+    }
+    if (d2.size() < 3) return kHeadingMinSpeed_m_s;
+    const size_t mid = d2.size() / 2;
+    std::nth_element(d2.begin(), d2.begin() + static_cast<std::ptrdiff_t>(mid), d2.end());
+    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid), steps.end());
+    const float sigma = d2[mid] / (1.1774f * std::sqrt(6.0f));
+    // The velocity between two samples h apart has a noise of sqrt(2) sigma / h per axis.
+    const float noise = std::sqrt(2.0f) * sigma / static_cast<float>(steps[mid]);
+    return std::max(kHeadingMinSpeed_m_s, kHeadingNoiseSigmas * noise);
+  }
   void update_live(float dt_s);
 
   std::string name_;
@@ -67,6 +93,9 @@ class TrajectoryReplay final : public CrowdSource {
   std::vector<uint32_t> track_ids_;
   std::vector<uint32_t> sample_begin_, sample_end_;
   std::vector<float> initial_theta_;
+  // Per track: theta follows v only faster than this [m/s] (kHeadingMinSpeed_m_s, or more for a
+  // track whose samples jitter: heading_speed).
+  std::vector<float> heading_speed_;
   // Samples: time [s], position (x, z) [m], C1 Hermite tangent [m/s].
   std::vector<double> sample_time_s_;
   std::vector<glm::vec2> sample_pos_;
@@ -123,6 +152,8 @@ TrajectoryReplay::TrajectoryReplay(std::string name, const TrajectoryTable& tabl
     // slopes inside. Gaps (missing frames) are just longer intervals of the same spline.
     float theta0 = 0.0f;
     bool have_theta0 = false;
+    const float min_speed = heading_speed(begin, end);
+    heading_speed_.push_back(min_speed);
     for (uint32_t i = begin; i < end; ++i) {
       glm::vec2 m(0.0f);
       if (end - begin >= 2) {
@@ -140,7 +171,7 @@ TrajectoryReplay::TrajectoryReplay(std::string name, const TrajectoryTable& tabl
         }
       }
       sample_tangent_[i] = m;
-      if (!have_theta0 && glm::length(m) >= kHeadingMinSpeed_m_s) {
+      if (!have_theta0 && glm::length(m) >= min_speed) {
         theta0 = heading_of(m);
         have_theta0 = true;
       }
@@ -245,11 +276,18 @@ void TrajectoryReplay::update_live(float dt_s) {
           hf;
     }
 
-    const float speed = glm::length(v);
+    // Heading from v when the pedestrian walks: v fast enough, and on a jittering track (whose
+    // spline overshoots between noisy samples) also the segment's own chord.
+    const float min_speed = heading_speed_[k];
+    const bool heading =
+        glm::length(v) >= min_speed &&
+        (min_speed <= kHeadingMinSpeed_m_s || c == last ||
+         glm::length(sample_pos_[c + 1] - sample_pos_[c]) >=
+             min_speed * static_cast<float>(sample_time_s_[c + 1] - sample_time_s_[c]));
     if (i >= first_new) {
       // A newcomer faces where it walks right away; no smoothing from a stale value.
-      theta_[k] = speed >= kHeadingMinSpeed_m_s ? heading_of(v) : initial_theta_[k];
-    } else if (speed >= kHeadingMinSpeed_m_s) {
+      theta_[k] = heading ? heading_of(v) : initial_theta_[k];
+    } else if (heading) {
       theta_[k] = wrap_angle(theta_[k] + wrap_angle(heading_of(v) - theta_[k]) * blend);
     }
     out_ids_[i] = track_ids_[k];

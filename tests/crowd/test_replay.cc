@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <random>
 #include <sstream>
 #include <vector>
 
@@ -446,6 +447,42 @@ TEST(TrajectoryReplay, SyntheticTracksGapsAndHeadings) {
   EXPECT_EQ(replay->frame().size(), 1u);
   for (int k = 0; k < 8; ++k) ASSERT_TRUE(replay->step(0.1f).ok());
   EXPECT_EQ(replay->frame().size(), 0u);
+}
+
+// A tracker's noise (2 cm per axis, Gaussian, every 0.4 s sample): a pedestrian who stands keeps
+// facing where he faced instead of turning after each wobble (its velocity reaches 0.1-0.3 m/s in a
+// new direction every sample), while one who walks at 0.5 m/s through the same noise faces his way.
+// A track without noise keeps the 0.1 m/s threshold (SyntheticTracksGapsAndHeadings).
+TEST(TrajectoryReplay, NoisyStanderKeepsItsHeadingAndANoisyWalkerFacesItsWay) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  std::ostringstream text;
+  for (int k = 0; k <= 60; ++k) {  // 24 s
+    text << 10 * k << " 1 " << 1.0 + noise(rng) << ' ' << 2.0 + noise(rng) << '\n';
+    text << 10 * k << " 2 " << 0.2 * k + noise(rng) << ' ' << 5.0 + noise(rng) << '\n';
+  }
+  auto replay = load(write_scratch("noisy.txt", text.str()), 0.4f);
+  ASSERT_TRUE(replay);
+  double turned = 0.0, fast = 0.0;
+  int off_course = 0, frames = 0;
+  float last = replay->frame().thetas[0];
+  for (int f = 0; f < 60 * 23; ++f) {
+    ASSERT_TRUE(replay->step(1.0f / 60.0f).ok());
+    const AgentFrame fr = replay->frame();
+    ASSERT_EQ(fr.size(), 2u);
+    const int stander = fr.ids[0] == 1 ? 0 : 1, walker = 1 - stander;
+    float d = fr.thetas[stander] - last;
+    d = std::atan2(std::sin(d), std::cos(d));
+    turned += std::abs(d);
+    last = fr.thetas[stander];
+    fast = std::max(fast, static_cast<double>(glm::length(fr.velocities[stander])));
+    // The walker goes +x (file x): theta pi/2.
+    off_course += std::abs(fr.thetas[walker] - 1.5707963f) > 0.5f;
+    ++frames;
+  }
+  EXPECT_GT(fast, 0.2) << "the noise moves the stander at walking-like speeds";
+  EXPECT_LT(turned, 0.5) << "radians the stander turned in 23 s";
+  EXPECT_LT(off_course, frames / 20) << "frames the walker faced 30 degrees off its way";
 }
 
 TEST(TrajectoryReplay, LoopStartsOverOneStepAfterTheLastSample) {
