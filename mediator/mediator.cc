@@ -97,6 +97,10 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
 
 void Mediator::set_params(const MediatorParams& p) {
   params_ = p;
+  // No agent stays held through its jitter by a gate now off (LOD advance_agent reads it).
+  if (!p.stand_through_jitter || p.mode != MediatorMode::kApm) {
+    std::fill(jitter_held_.begin(), jitter_held_.end(), uint8_t{0});
+  }
   degraded_ = p.mode == MediatorMode::kApm && library_doubtful_;
   if (degraded_) params_.mode = MediatorMode::kNaive;
 }

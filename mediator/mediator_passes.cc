@@ -165,38 +165,43 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
     float speed = glm::length(st.vel[slot]);
     bool stand = speed < P.stop_speed_m_s;
     uint8_t held = 0;
-    if (jitter_gate && usable_position(p_in)) {
-      glm::vec2& at = st.still_at[slot];
-      float& jitter2 = st.still_jitter2[slot];
-      if (c.fresh[slot] || jitter2 < 0.0f) {  // new, or the gate was off: nothing known yet
-        at = p;
-        jitter2 = 0.0f;
-      }
-      const bool stood = !c.fresh[slot] && out_standing[slot] != 0;
-      const float a = one_step ? still_a : 1.0f - std::exp(-dt / kStillAverageTime);
-      if (stood) {
-        const glm::vec2 off = p - at;
-        const float d2 = glm::dot(off, off);
-        // Held no further than a standing body's feet reach without a step (idle_step_distance_m):
-        // a start is let go by then at the latest, whatever the jitter seen.
-        const float r = std::min(kStartJitterSigmas * std::sqrt(jitter2), reach);
-        if (!stand && d2 < r * r) {
-          stand = true;  // it stays where it stands: jitter, not a start
-          speed = 0.0f;
-          held = 1;
+    if (jitter_gate) {
+      if (usable_position(p_in)) {
+        glm::vec2& at = st.still_at[slot];
+        float& jitter2 = st.still_jitter2[slot];
+        if (c.fresh[slot] || jitter2 < 0.0f) {  // new, or the gate was off: nothing known yet
+          at = p;
+          jitter2 = 0.0f;
         }
-        // The jitter about where it stands, over every frame it stands; a frame adds no more
-        // than the reach, so a start it holds cannot raise the limit past it.
-        jitter2 += (std::min(d2, reach * reach) - jitter2) * a;
-      }
-      if (stand && !stood) {
-        // Stopped somewhere new: it stands here. Back where it stood before (a wobble let go as a
-        // start that went nowhere), that place stays, its average kept.
-        const glm::vec2 off = p - at;
-        if (glm::dot(off, off) > reach * reach) at = p;
-      } else if (stand && !held) {
-        at += (p - at) * a;  // where it stands moves with a slow p, not with a held one
-      }
+        const bool stood = !c.fresh[slot] && out_standing[slot] != 0;
+        const float a = one_step ? still_a : 1.0f - std::exp(-dt / kStillAverageTime);
+        if (stood) {
+          const glm::vec2 off = p - at;
+          const float d2 = glm::dot(off, off);
+          // Held no further than a standing body's feet reach without a step
+          // (idle_step_distance_m): a start is let go by then at the latest, whatever the jitter
+          // seen.
+          const float r = std::min(kStartJitterSigmas * std::sqrt(jitter2), reach);
+          if (!stand && d2 < r * r) {
+            stand = true;  // it stays where it stands: jitter, not a start
+            speed = 0.0f;
+            held = 1;
+          }
+          // The jitter about where it stands, over every frame it stands; a frame adds no more
+          // than the reach, so a start it holds cannot raise the limit past it.
+          jitter2 += (std::min(d2, reach * reach) - jitter2) * a;
+        }
+        if (stand && !stood) {
+          // Stopped somewhere new: it stands here. Back within twice its hold of where it stood
+          // before (a wobble let go as a start that went nowhere), that place stays, its average
+          // kept; a clean track (no jitter, no hold) always stands where it stopped.
+          const glm::vec2 off = p - at;
+          const float back = 2.0f * std::min(kStartJitterSigmas * std::sqrt(jitter2), reach);
+          if (glm::dot(off, off) > back * back) at = p;
+        } else if (stand && !held) {
+          at += (p - at) * a;  // where it stands moves with a slow p, not with a held one
+        }
+      }  // an unusable p leaves the state as it was
     } else if (!st.still_jitter2.empty()) {
       st.still_jitter2[slot] = -1.0f;  // unknown when the gate is next on
     }

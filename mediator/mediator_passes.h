@@ -123,7 +123,8 @@ struct FilterState {
   std::span<glm::vec2> vel, vel_rate;  // [m/s], [m/s^2]
   std::span<float> theta, theta_rate;  // unwrapped [rad], [rad/s]
   // With the gate (filter_pass): where a standing agent stands (p averaged over
-  // kStillAverageTime while it stands with a slow p; kept while it is held), the mean square of
+  // kStillAverageTime while it stands with a slow p; kept while it is held, and when it stops
+  // again within twice its hold of there), the mean square of
   // p's distance from there over its standing frames (each at most the hold's reach) [m^2]
   // (-1: unknown, the gate was off), and (out) whether it stands this frame only because p moved
   // within that jitter.
@@ -135,8 +136,10 @@ struct FilterState {
 // speeds (2 cm of noise every 0.4 s: about 0.1 m/s, in a new direction each sample), but never
 // away: such an agent stays standing while p is within kStartJitterSigmas times the
 // root-mean-square of its jitter of where it stands, and never further than a re-planting step
-// (MediatorParams::idle_step_distance_m: a standing body's feet take up that much). A clean
-// track's jitter is about nil: its starts are not delayed. Averages over kStillAverageTime [s].
+// (MediatorParams::idle_step_distance_m: a standing body's feet take up that much). The jitter is
+// learnt on held frames too, so a start from a noisy stand is let go at about that distance. A
+// clean track's jitter is about nil: its starts are not delayed. Averages over
+// kStillAverageTime [s].
 inline constexpr float kStartJitterSigmas = 3.0f;
 inline constexpr float kStillAverageTime = 1.0f;
 // Per agent: the frame's values with unusable ones replaced by the agent's last good ones.

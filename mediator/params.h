@@ -52,9 +52,9 @@ struct MediatorParams {
   // swing ends sooner, rather than the support foot being overstretched and let go.
   bool quicken_steps = true;
   // A source that takes no feedback (a recording): a standing agent starts walking only once its
-  // p leaves where it stands by more than three times its jitter (tracker noise) or by a
-  // re-planting step (idle_step_distance_m), instead of walking and turning after every wobble
-  // (filter_pass).
+  // p leaves where it stands by more than three times its jitter (tracker noise), and at most by
+  // a re-planting step (idle_step_distance_m: in practice a start from a noisy stand is let go
+  // there), instead of walking and turning after every wobble (filter_pass).
   bool stand_through_jitter = true;
   // 8. Feedback to the simulator.
   bool feedback = true;

@@ -131,8 +131,9 @@ struct StandingRun {
 };
 StandingRun run_standing(bool gate, float dt, std::function<glm::vec2(double)> vel, double t_end,
                          bool lod_far = false,
-                         std::function<void(CrowdPipeline&, int)> hook = nullptr) {
-  std::vector<Script> s{{{2.0f, 1.0f}, std::move(vel), [](double, glm::vec2) { return 0.0f; }}};
+                         std::function<void(CrowdPipeline&, int)> hook = nullptr,
+                         glm::vec2 start = {2.0f, 1.0f}) {
+  std::vector<Script> s{{start, std::move(vel), [](double, glm::vec2) { return 0.0f; }}};
   test::ScriptedCrowd crowd(std::move(s));
   MediatorParams p;
   p.stand_through_jitter = gate;
@@ -205,6 +206,23 @@ TEST(Mediator, StandingThroughJitterKeepsCleanStartsOnTime) {
   EXPECT_EQ(first_walking(on, 1), first_walking(off, 1));
 }
 
+// A clean pedestrian who stands, shuffles 8 cm and stops again, then sets off: the shuffle is not
+// taken for jitter (no delay against the gate off).
+TEST(Mediator, StandingThroughJitterDoesNotTakeAShuffleForJitter) {
+  constexpr float kDt = 1.0f / 60.0f;
+  auto vel = [](double t) {
+    double v = 0.0;
+    if (t >= 1.0 && t < 1.4) v = 0.2 * std::sin(std::numbers::pi * (t - 1.0) / 0.4);  // ~5 cm
+    if (t >= 2.5) v = 1.3 * ease(t - 2.5);
+    return glm::vec2(0.0f, static_cast<float>(v));
+  };
+  const StandingRun on = run_standing(true, kDt, vel, 5.0);
+  const StandingRun off = run_standing(false, kDt, vel, 5.0);
+  const int from = static_cast<int>(2.5 / kDt);
+  ASSERT_GE(first_walking(off, from), from);
+  EXPECT_EQ(first_walking(on, from), first_walking(off, from));
+}
+
 // One whose p wobbles about where it stands stays standing once it has shown its jitter (without
 // the gate it walks on many frames); when it then walks off slowly (0.3 m/s, still wobbling) it is
 // let go within a second, before p has left where it stood by more than a re-planting step.
@@ -239,7 +257,9 @@ TEST(Mediator, StandingThroughJitterHoldsAWobbleAndLetsASlowStartGo) {
 }
 
 // Switched from naive to APM while it stands (the panel's mode), it knows nothing of where it
-// stood under naive: its start is on time, as when it had been in APM all along.
+// stood before: its start is on time, as when it had been in APM all along. It stands 5 cm from
+// the origin, where a slot's state starts: taken for where it stood, that distance would pass for
+// jitter and hold the start.
 TEST(Mediator, StandingThroughJitterStartsAfreshWhenTheGateComesOn) {
   constexpr float kDt = 1.0f / 60.0f;
   auto start = [](double t) { return glm::vec2(0.0f, static_cast<float>(1.3 * ease(t - 4.0))); };
@@ -249,8 +269,9 @@ TEST(Mediator, StandingThroughJitterStartsAfreshWhenTheGateComesOn) {
     p.mode = f == 0 ? MediatorMode::kNaive : MediatorMode::kApm;
     pipeline.set_params(p);
   };
-  const StandingRun sw = run_standing(true, kDt, start, 7.0, false, switched);
-  const StandingRun apm = run_standing(true, kDt, start, 7.0);
+  const glm::vec2 at(0.05f, 0.0f);
+  const StandingRun sw = run_standing(true, kDt, start, 7.0, false, switched, at);
+  const StandingRun apm = run_standing(true, kDt, start, 7.0, false, nullptr, at);
   const int from = static_cast<int>(4.0 / kDt);
   ASSERT_GE(first_walking(apm, from), from);
   EXPECT_EQ(first_walking(sw, from), first_walking(apm, from));
