@@ -124,10 +124,9 @@ struct FilterState {
   std::span<float> theta, theta_rate;  // unwrapped [rad], [rad/s]
   // With the gate (filter_pass): where a standing agent stands (p averaged over
   // kStillAverageTime while it stands with a slow p; kept while it is held, and when it stops
-  // again within twice its hold of there), the mean square of
-  // p's distance from there over its standing frames (each at most the hold's reach) [m^2]
-  // (-1: unknown, the gate was off), and (out) whether it stands this frame only because p moved
-  // within that jitter.
+  // again within twice its hold of there), the mean square of p's distance from there over its
+  // standing frames (each at most the hold's reach) [m^2] (-1: unknown, the gate was off), and
+  // (out) whether it stands this frame only because p moved within that jitter.
   std::span<glm::vec2> still_at;
   std::span<float> still_jitter2;
   std::span<uint8_t> jitter_held;

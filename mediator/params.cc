@@ -60,7 +60,7 @@ constexpr ParamInfo kInfos[] = {
      0.0f, 1.0f, K::kBool, nullptr, &P::quicken_steps},
     {"stand_through_jitter", "on/off",
      "recordings (no feedback): a standing agent walks only once p leaves where it stands by "
-     "more than 3 times its jitter or a re-planting step",
+     "more than 3 times its jitter (a re-planting step at most)",
      0.0f, 1.0f, K::kBool, nullptr, &P::stand_through_jitter},
     {"feedback", "on/off", "send the p/v/theta the animation can deliver back to the simulator",
      0.0f, 1.0f, K::kBool, nullptr, &P::feedback},
