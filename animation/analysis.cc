@@ -225,8 +225,7 @@ constexpr float kContactHysteresis = 1.5f;
 
 // The capture's own position jitter [m, per axis and frame], from the feet's horizontal second
 // differences: a planted foot has none in a clean capture and most frames of a gait plant one
-// of the two feet, so their median is jitter (a 2-D second difference of white noise of sigma
-// per axis has a median length of 1.1774 * sqrt(6) sigma).
+// of the two feet, so their median is jitter (sigma_from_second_differences).
 float capture_jitter_m(const Tracks& tr) {
   std::vector<float> d2;
   for (int s = 0; s < 2; ++s) {
@@ -237,7 +236,7 @@ float capture_jitter_m(const Tracks& tr) {
       }
     }
   }
-  return d2.empty() ? 0.0f : percentile(d2, 0.5f) / (1.1774f * std::sqrt(6.0f));
+  return sigma_from_second_differences(std::move(d2));
 }
 
 // Frames on either side for velocities: about 1/60 s (one frame up to 90 fps), longer where the

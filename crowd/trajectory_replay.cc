@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "common/stats.h"
 #include "crowd/trajectory_file.h"
 
 namespace gk {
@@ -64,26 +65,21 @@ class TrajectoryReplay final : public CrowdSource {
  private:
   // The speed [m/s] above which track [begin, end)'s heading is its walking direction rather than
   // its samples' jitter: kHeadingMinSpeed_m_s, or three times the velocity noise its positions'
-  // jitter makes (the jitter from the median second difference of evenly spaced samples, as the
-  // clip analysis takes a capture's: 1.1774 * sqrt(6) sigma for white noise of sigma per axis).
+  // jitter makes (the jitter from the second differences of its evenly spaced samples, as clip
+  // analysis takes a capture's: sigma_from_second_differences).
   float heading_speed(uint32_t begin, uint32_t end) const {
-    std::vector<float> d2;
-    std::vector<double> steps;
+    std::vector<float> d2, steps;
     for (uint32_t i = begin + 1; i + 1 < end; ++i) {
       const double h0 = sample_time_s_[i] - sample_time_s_[i - 1];
       const double h1 = sample_time_s_[i + 1] - sample_time_s_[i];
       if (!(h0 > 0.0) || std::abs(h1 - h0) > 1e-3 * h0) continue;  // a gap: not a second difference
-      const glm::vec2 d = sample_pos_[i + 1] - 2.0f * sample_pos_[i] + sample_pos_[i - 1];
-      d2.push_back(glm::length(d));
-      steps.push_back(h0);
+      d2.push_back(glm::length(sample_pos_[i + 1] - 2.0f * sample_pos_[i] + sample_pos_[i - 1]));
+      steps.push_back(static_cast<float>(h0));
     }
     if (d2.size() < 3) return kHeadingMinSpeed_m_s;
-    const size_t mid = d2.size() / 2;
-    std::nth_element(d2.begin(), d2.begin() + static_cast<std::ptrdiff_t>(mid), d2.end());
-    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid), steps.end());
-    const float sigma = d2[mid] / (1.1774f * std::sqrt(6.0f));
     // The velocity between two samples h apart has a noise of sqrt(2) sigma / h per axis.
-    const float noise = std::sqrt(2.0f) * sigma / static_cast<float>(steps[mid]);
+    const float noise =
+        std::sqrt(2.0f) * sigma_from_second_differences(std::move(d2)) / percentile(steps, 0.5);
     return std::max(kHeadingMinSpeed_m_s, kHeadingNoiseSigmas * noise);
   }
   void update_live(float dt_s);

@@ -67,7 +67,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   theta_.assign(capacity, 0.0f);
   theta_rate_.assign(capacity, 0.0f);
   still_at_.assign(capacity, glm::vec2(0.0f));
-  still_jitter2_.assign(capacity, 0.0f);
+  still_jitter2_.assign(capacity, -1.0f);
   jitter_held_.assign(capacity, 0);
   root_heading_.assign(capacity, 0.0f);
   lower_target_.assign(capacity, 0.0f);
@@ -97,10 +97,6 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
 
 void Mediator::set_params(const MediatorParams& p) {
   params_ = p;
-  // No agent stays held through its jitter by a gate now off (LOD advance_agent reads it).
-  if (!p.stand_through_jitter || p.mode != MediatorMode::kApm) {
-    std::fill(jitter_held_.begin(), jitter_held_.end(), uint8_t{0});
-  }
   degraded_ = p.mode == MediatorMode::kApm && library_doubtful_;
   if (degraded_) params_.mode = MediatorMode::kNaive;
 }
@@ -230,6 +226,19 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   // Plans made without LOD kept no gait frequency for the advance.
   if (lod && !lod_was_on_) std::fill(lod_cycles_valid_.begin(), lod_cycles_valid_.end(), 0);
   lod_was_on_ = lod;
+  // Standing through a recording's jitter (filter_pass): a recording's p jitters with its
+  // tracker's noise; a simulator's is where its agent is (its jitter is answered with feedback).
+  // Once the gate goes off (parameters, mode or source), nothing it learnt or held carries over:
+  // held roots are let go (LOD advance_agent reads them) and the state is unknown (-1) until it
+  // is next on.
+  const bool stand_through_jitter = params_.mode == MediatorMode::kApm &&
+                                    params_.stand_through_jitter &&
+                                    policy == FeedbackPolicy::kIgnored;
+  if (!stand_through_jitter && jitter_gate_was_on_) {
+    std::fill(jitter_held_.begin(), jitter_held_.end(), uint8_t{0});
+    std::fill(still_jitter2_.begin(), still_jitter2_.end(), -1.0f);
+  }
+  jitter_gate_was_on_ = stand_through_jitter;
   const float pull = root_pull(dt_s);
   if (lod) {
     // Per agent and its own slot only: in parallel, as the passes.
@@ -257,10 +266,6 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                         lod ? std::span<const uint8_t>(lod_plan_) : std::span<const uint8_t>(),
                         lod ? std::span<const float>(lod_dt_s_) : std::span<const float>()};
   const bool honoured = params_.feedback && policy == FeedbackPolicy::kHonoured;
-  // A recording's p jitters with its tracker's noise; a simulator's is where its agent is (its
-  // jitter is answered with feedback).
-  const bool stand_through_jitter =
-      params_.stand_through_jitter && policy == FeedbackPolicy::kIgnored;
   filter_pass(crowd, frame, pl.root_xz,
               {vel_, vel_rate_, theta_, theta_rate_, still_at_, still_jitter2_, jitter_held_},
               stand_through_jitter, {sim_pos_, sim_vel_, sim_theta_}, pl.speed_m_s, pl.standing);
@@ -328,8 +333,7 @@ void Mediator::advance_agent(int agent, int slot, const glm::vec2& p_in, const g
   if (params_.mode != MediatorMode::kApm) {
     pl.root_xz[slot] = p;
   } else if (jitter_held_[slot]) {
-    pl.root_xz[slot] =
-        near_p(pulled_root(pl.root_xz[slot], glm::vec2(0.0f), still_at_[slot], dt, pull), p);
+    pl.root_xz[slot] = held_root(pl.root_xz[slot], still_at_[slot], p, dt, pull);
   } else {
     pl.root_xz[slot] = pulled_root(pl.root_xz[slot], vel_[slot], p, dt, pull);
   }

@@ -150,6 +150,7 @@ class Mediator {
   std::span<const uint8_t> lod_due_;
   std::span<const SupportReach> support_reach_;
   bool support_hold_allowed_ = false;
+  bool jitter_gate_was_on_ = false;  // stand_through_jitter acted in the last plan
   std::vector<glm::vec2> hold_;
   std::vector<float> hold_scale_;
   std::vector<float> root_speed_;  // the drawn root's speed last frame [m/s]

@@ -175,13 +175,13 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
         }
         const bool stood = !c.fresh[slot] && out_standing[slot] != 0;
         const float a = one_step ? still_a : 1.0f - std::exp(-dt / kStillAverageTime);
+        // How far p may stray from where it stands and still be jitter: no further than a
+        // standing body's feet reach without a step (idle_step_distance_m), so a start is let go
+        // by then at the latest, whatever the jitter seen.
+        const float r = std::min(kStartJitterSigmas * std::sqrt(jitter2), reach);
         if (stood) {
           const glm::vec2 off = p - at;
           const float d2 = glm::dot(off, off);
-          // Held no further than a standing body's feet reach without a step
-          // (idle_step_distance_m): a start is let go by then at the latest, whatever the jitter
-          // seen.
-          const float r = std::min(kStartJitterSigmas * std::sqrt(jitter2), reach);
           if (!stand && d2 < r * r) {
             stand = true;  // it stays where it stands: jitter, not a start
             speed = 0.0f;
@@ -196,16 +196,13 @@ void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const gl
           // before (a wobble let go as a start that went nowhere), that place stays, its average
           // kept; a clean track (no jitter, no hold) always stands where it stopped.
           const glm::vec2 off = p - at;
-          const float back = 2.0f * std::min(kStartJitterSigmas * std::sqrt(jitter2), reach);
-          if (glm::dot(off, off) > back * back) at = p;
+          if (glm::dot(off, off) > 4.0f * r * r) at = p;
         } else if (stand && !held) {
           at += (p - at) * a;  // where it stands moves with a slow p, not with a held one
         }
       }  // an unusable p leaves the state as it was
-    } else if (!st.still_jitter2.empty()) {
-      st.still_jitter2[slot] = -1.0f;  // unknown when the gate is next on
+      st.jitter_held[slot] = held;
     }
-    if (!st.jitter_held.empty()) st.jitter_held[slot] = held;
     out_speed[slot] = speed;
     out_standing[slot] = stand;
   });
@@ -234,11 +231,9 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
     out_hold_scale[slot] = 1.0f;
     if (apm && !c.fresh[slot]) {
       const bool held = !jitter_held.empty() && jitter_held[slot];
-      glm::vec2 root =
-          held ? near_p(pulled_root(root_xz[slot], glm::vec2(0.0f), still_at[slot], dt,
-                                    one_step ? pull : root_pull(dt)),
-                        p)
-               : pulled_root(root_xz[slot], vel, p, dt, one_step ? pull : root_pull(dt));
+      const float k = one_step ? pull : root_pull(dt);
+      glm::vec2 root = held ? held_root(root_xz[slot], still_at[slot], p, dt, k)
+                            : pulled_root(root_xz[slot], vel, p, dt, k);
       // A foot that carries the body alone holds it back (a source that takes feedback only:
       // one that does not would just be caught up with later). Until the other foot comes down
       // the root may cover what is left of the support leg's reach, no more: its speed away from

@@ -84,6 +84,12 @@ inline glm::vec2 pulled_root(const glm::vec2& root, const glm::vec2& vel, const 
   const glm::vec2 predicted = root + vel * dt;
   return near_p(predicted + (p - predicted) * pull, p);
 }
+// The drawn root of an agent held standing through its jitter (filter_pass): pulled toward where
+// it stands, `still_at`, with no motion of its own, and never more than kMaxRootOffset from p.
+inline glm::vec2 held_root(const glm::vec2& root, const glm::vec2& still_at, const glm::vec2& p,
+                           float dt, float pull) {
+  return near_p(pulled_root(root, glm::vec2(0.0f), still_at, dt, pull), p);
+}
 
 // A layer's clip time: a gait clip's at the shared gait phase, a standing clip's on its clock, a
 // transition's on its own (`transition_time_s`).
@@ -125,8 +131,9 @@ struct FilterState {
   // With the gate (filter_pass): where a standing agent stands (p averaged over
   // kStillAverageTime while it stands with a slow p; kept while it is held, and when it stops
   // again within twice its hold of there), the mean square of p's distance from there over its
-  // standing frames (each at most the hold's reach) [m^2] (-1: unknown, the gate was off), and
-  // (out) whether it stands this frame only because p moved within that jitter.
+  // standing frames (each at most the hold's reach) [m^2] (-1: unknown, as when the gate was off:
+  // Mediator::plan marks it), and (out, with the gate) whether it stands this frame only because
+  // p moved within that jitter.
   std::span<glm::vec2> still_at;
   std::span<float> still_jitter2;
   std::span<uint8_t> jitter_held;
