@@ -40,14 +40,16 @@ void sanitise(FootLockInput& out) {
 // more than the arithmetic. The public functions at the end keep their value form.
 
 // A pinned toe follows the clip's toe down onto the floor as the foot rolls from the heel onto
-// the ball. It rises with the clip's only while the other foot is pinned: that one carries the
-// weight, and this one pivots onto its toes to push off; alone on the ground, the ball bears the
-// weight and stays down (the heel rises about it). It rises as fast as the clip's does this frame;
+// the ball. It rises with the clip's while the other foot is pinned: that one carries the weight,
+// and this one pivots onto its toes to push off; and in a run, whose push-off is on the toes too,
+// into the air (held down until the clips let it go, the ball was then snatched up centimetres in
+// a frame or two, snapping the knee). Alone on the ground in a walk, the ball bears the weight and
+// stays down (the heel rises about it). It rises as fast as the clip's does this frame;
 // what it has to catch up beyond that (the clip's toe already higher when the other foot is
 // pinned) goes through the settling offset, so the drawn toe never jumps.
 void pin_height(FootLock& s, const FootLockInput& in) {
   const float clip_y = std::max(in.floor_toe_m, in.anim_toe.y);
-  if (in.other_locked && clip_y > s.target.y) {
+  if ((in.other_locked || in.flight) && clip_y > s.target.y) {
     const float clip_rise = std::max(0.0f, in.anim_toe.y - in.anim_toe_prev.y);
     s.offset.y -= std::max(0.0f, clip_y - s.target.y - clip_rise);
     s.target.y = clip_y;

@@ -10,7 +10,8 @@
 // correction happens in the air, and the swing keeps the clip's own height. A foot that lands
 // settles onto the floor through a decaying offset (a critically damped spring, exact for any
 // step). A pinned toe follows the clip's down as the foot rolls onto its ball, and up only while
-// the other foot is pinned (pushing off onto the toes). A pinned foot left far behind by a turn or
+// the other foot is pinned or the clips run (pushing off onto the toes). A pinned foot left far
+// behind by a turn or
 // a drift re-plants (start_foot_step), while the other foot is pinned, with a short step as high as
 // the clips' own swing.
 //
@@ -83,6 +84,9 @@ struct FootLockInput {
   // it back to the clip's foot, so a drift alone starts no re-planting step (a step would lift it
   // while the other foot may still be rolling down onto its ball: both off the ground).
   bool walking = false;
+  // The clips run (they have a flight phase, no double support): the foot pushes off on its toes
+  // into the air, not onto the other foot, and its ball rises with the clips' as it does.
+  bool flight = false;
   // The other foot is in the air and coming down (walking: in the clips and not pinned yet; or in
   // a re-planting step), or pinned on its heel and still rolling down onto its ball: this one
   // keeps its weight (its lock) until the other has taken it over, as a trailing foot stays down

@@ -238,7 +238,11 @@ float stance_sweep_speed(const LocomotionClip& lc, const Skeleton& sk) {
   return sweep.empty() ? 0.0f : percentile(std::move(sweep), 0.5);
 }
 
-void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
+constexpr float kGravity = 9.81f;          // [m/s^2]
+constexpr float kTransitionFroude = 0.5f;  // walk-run transition (Alexander; GAIT.md's 2 m/s)
+
+// max_rest_m_s: LocomotionLibrary::max_rest_speed_m_s.
+void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk, float max_rest_m_s) {
   // Each foot's contacts as clip analysis finds them.
   const std::vector<uint8_t> down[2] = {
       contact_frames(lc->analysis, 0, lc->clip.num_frames, lc->clip.fps, false),
@@ -287,7 +291,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk) {
     // trimmed to where the ball rests. (Clips authored in place are judged by the direction their
     // stance foot is carried, not its speed over the ground, which keyframes need not keep.)
     if (!lc->analysis.in_place) {
-      const float rest = still_speed_m_s(glm::length(travel));
+      const float rest = std::min(still_speed_m_s(glm::length(travel)), max_rest_m_s);
       std::vector<uint8_t>& pl = lc->plant[s];
       int first_free = -1;
       for (int f = 0; f < n && first_free < 0; ++f) {
@@ -966,6 +970,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   const std::vector<glm::mat4> rest = rest_model(sk);
   for (int s = 0; s < 2; ++s) lib.leg_length_m[s] = leg_length(sk, rest, static_cast<Side>(s));
   const float dst_leg = 0.5f * (lib.leg_length_m[0] + lib.leg_length_m[1]);
+  lib.max_rest_speed_m_s = still_speed_m_s(std::sqrt(kTransitionFroude * kGravity * dst_leg));
 
   // Every clip that does not make it into the library is named with the reason, never dropped
   // silently.
@@ -1002,7 +1007,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     lc.direction_rad = lc.analysis.direction_rad;
     lc.clip = make_in_place(c, sk, lc.analysis, facing);
     if (take != nullptr) lc.source = *take;
-    fill_contacts_and_heights(&lc, sk);
+    fill_contacts_and_heights(&lc, sk, lib.max_rest_speed_m_s);
     const bool both_feet = !lc.analysis.contacts[0].empty() && !lc.analysis.contacts[1].empty();
     char speed[64];  // "%.2f" of any float fits
     std::snprintf(speed, sizeof(speed), "%.2f m/s", lc.speed_m_s);
@@ -1346,7 +1351,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       if (std::abs(common - planted[i]) < 1e-6f) continue;
       raise_clip(&c, common - planted[i]);
       if (c.gait) {
-        fill_contacts_and_heights(&c, sk);
+        fill_contacts_and_heights(&c, sk, lib.max_rest_speed_m_s);
         drop_doubtful_locks(&c);  // the refill above set them again
       } else {
         for (int s = 0; s < 2; ++s) {
@@ -1422,8 +1427,6 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     if (c.gait) set_lift_phases(&c);
   }
   {
-    constexpr float kGravity = 9.81f;          // [m/s^2]
-    constexpr float kTransitionFroude = 0.5f;  // walk-run transition (Alexander; GAIT.md's 2 m/s)
     const float hip_height = 0.5f * (lib.leg_length_m[0] + lib.leg_length_m[1] +
                                      lib.planted_ankle_m[0] + lib.planted_ankle_m[1]);
     if (hip_height > 0.0f) {

@@ -30,6 +30,7 @@ struct Foot {
   FootLockParams params;
   glm::vec3 goal{0.0f}, anim{0.0f};
   bool started = false;
+  bool flight = false;  // the clips run
   glm::vec3 step(const glm::vec3& anim_toe, bool plant, bool hold, float progress = 0.0f,
                  bool other_locked = false, float still_speed = 0.0f, float clip_speed = -1.0f) {
     FootLockInput in;
@@ -41,6 +42,8 @@ struct Foot {
     in.hold = hold;
     in.swing_progress = progress;
     in.other_locked = other_locked;
+    in.walking = flight;
+    in.flight = flight;
     in.floor_toe_m = kFloor;
     in.still_speed_m_s = still_speed;
     in.clip_speed_m_s = clip_speed;
@@ -78,6 +81,41 @@ TEST(FootLock, PlantedFootIsPinnedWhereItWasDrawnAndOnlyComesDown) {
   // Settled on the floor: the 1 cm landing offset decays with a 0.06 s halflife, and 38 frames
   // (0.63 s, over 10 halflives) leave far less than 0.1 mm.
   EXPECT_NEAR(prev.y, kFloor, 1e-4f);
+}
+
+// A runner pushes off on its toes into the air: the clips raise the ball while the other foot is
+// off the ground. Walking, alone on the ground, the ball bears the weight and stays down; running,
+// it rises with the clips' (held down, it was snatched up by the whole rise in the frames after
+// the release). Either way, released, it never jumps.
+TEST(FootLock, InARunThePinnedBallRisesWithThePushOff) {
+  for (const bool run : {false, true}) {
+    Foot foot;
+    foot.flight = run;
+    foot.step({0.0f, kFloor, 0.0f}, true, true);
+    ASSERT_EQ(foot.lock.state, FootLockState::kLocked);
+    // Push-off: the clip's ball rises 5 mm a frame for 8 frames, the weight still on it.
+    float highest = kFloor;
+    for (int f = 1; f <= 8; ++f) {
+      const glm::vec3 g = foot.step({0.0f, kFloor + 0.005f * f, 0.0f}, false, true);
+      ASSERT_EQ(foot.lock.state, FootLockState::kLocked) << f;
+      highest = g.y;
+    }
+    if (run) {
+      EXPECT_NEAR(highest, kFloor + 0.04f, 1e-5f);  // risen with the clip's ball
+    } else {
+      EXPECT_NEAR(highest, kFloor, 1e-6f);  // stays down: the heel rises about it
+    }
+    // Released as the clip's ball goes on rising at 5 mm a frame (0.3 m/s): the run's drawn ball
+    // goes on with it (the release's first frame lifts it by two frames' rise at most), the walk's
+    // catches up the whole push-off over the release, never at once.
+    float prev = highest, most = 0.0f;
+    for (int f = 9; f <= 12; ++f) {
+      const glm::vec3 g = foot.step({0.0f, kFloor + 0.005f * f, 0.0f}, false, false, 0.1f);
+      most = std::max(most, g.y - prev);
+      prev = g.y;
+    }
+    EXPECT_LT(most, run ? 0.0101f : 0.03f) << run;
+  }
 }
 
 // The clips may plant a foot whose ball still rolls forward off the heel: the lock waits until the

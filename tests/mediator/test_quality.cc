@@ -271,6 +271,29 @@ TEST(Quality, MannequinPedestriansBelowTheWalkRunSpeedWalk) {
   }
 }
 
+// A run's clips put the ball on the ground while it still travels at half the run's speed (clip
+// analysis's "still" for contact: 1.75 m/s for the CMU run), and a lock started there stopped the
+// drawn foot dead from that speed as it landed, every step (120 limb pops per agent-minute for a
+// runner at 3.5 m/s). A lock starts where the ball rests as a walker's does: below contact
+// analysis's still speed at the walk-run speed of the legs (Froude 0.5 on the leg length).
+TEST(Quality, RunnersFeetLandWithoutSnapping) {
+  GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
+  GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
+  auto lib =
+      test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const float leg = 0.5f * (lib->leg_length_m[0] + lib->leg_length_m[1]);
+  EXPECT_NEAR(lib->max_rest_speed_m_s, 0.5f * std::sqrt(0.5f * 9.81f * leg), 1e-3f);
+  EXPECT_LT(lib->max_rest_speed_m_s, 0.5f * lib->max_speed_m_s);  // tighter than a run's "still"
+  for (const float speed : {3.0f, 3.5f}) {
+    std::vector<test::Script> s;
+    for (int i = 0; i < 4; ++i) s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, speed}));
+    const auto apm = test::run_scripted(*lib, s, MediatorParams{}, 1200);
+    EXPECT_LE(apm.report.feet.limb_pop_rate, 1.0) << speed;
+    EXPECT_LE(apm.report.feet.penetration_max_cm, 1.5) << speed;
+  }
+}
+
 // Pedestrians who appear mid-stride (a recorded crowd's tracks begin anywhere) stand on their
 // support foot from the first frame: on the floor, pinned, and reached by the leg until the other
 // foot lands, as a walker's would be. The mannequin's walk blended with its jog at 1.4-1.7 m/s
