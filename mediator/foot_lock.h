@@ -9,11 +9,11 @@
 // (smoothly in the swing's progress, gone when the clip lands the foot), so no joint snaps, the
 // correction happens in the air, and the swing keeps the clip's own height. A foot that lands
 // settles onto the floor through a decaying offset (a critically damped spring, exact for any
-// step). A pinned toe follows the clip's down as the foot rolls onto its ball, and up only while
-// the other foot is pinned or the clips run (pushing off onto the toes). A pinned foot left far
-// behind by a turn or
-// a drift re-plants (start_foot_step), while the other foot is pinned, with a short step as high as
-// the clips' own swing.
+// step). A pinned toe follows the clip's down as the foot rolls onto its ball, and up while the
+// other foot is pinned (pushing off onto the toes) or, in a run, all through the stance (no other
+// foot takes the weight: the push-off is into the air); never while it alone bears a walker's
+// weight. A pinned foot left far behind by a turn or a drift re-plants (start_foot_step), while
+// the other foot is pinned, with a short step as high as the clips' own swing.
 //
 //   kFree      -> kLocked     plant_foot: the clips plant it and its ball has come to rest (or
 //                             rests in the clips, moving no faster than twice the still speed),
@@ -85,7 +85,9 @@ struct FootLockInput {
   // while the other foot may still be rolling down onto its ball: both off the ground).
   bool walking = false;
   // The clips run (they have a flight phase, no double support): the foot pushes off on its toes
-  // into the air, not onto the other foot, and its ball rises with the clips' as it does.
+  // into the air, not onto the other foot, and a pinned ball follows the clips' up as well as
+  // down all through the stance (held down while the clips rose, it was snatched up at the
+  // release: tried, gated to the push-off alone, the CMU run's slide and pops came back).
   bool flight = false;
   // The other foot is in the air and coming down (walking: in the clips and not pinned yet; or in
   // a re-planting step), or pinned on its heel and still rolling down onto its ball: this one

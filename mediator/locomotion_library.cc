@@ -463,9 +463,10 @@ LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
 // A take's stretch (a start or a stop, with its root motion) as a transition clip: facing turned
 // to +z, the root's travel taken out frame by frame along its path smoothed over a quarter
 // second (the pelvis keeps its sway), contacts and toe heights from clip analysis of the take's
-// stretch. `speed` gets that smoothed path's speed per frame.
-LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
-                                    std::vector<float>* speed) {
+// stretch. `speed` gets that smoothed path's speed per frame. max_rest_m_s:
+// LocomotionLibrary::max_rest_speed_m_s.
+LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk, std::vector<float>* speed,
+                                    float max_rest_m_s) {
   LocomotionClip lc;
   lc.analysis = analyze_clip(span, sk);
   lc.source = span;
@@ -501,7 +502,8 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
   lc.cycle_s = lc.clip.duration_s();
   // Contacts as clip analysis finds them in the take. As for a gait clip, a lock may start only
   // where the ball has come to rest over the ground (slower than half the root's speed, and never
-  // a stricter limit than contact analysis's), not while the heel strikes or the foot rolls off;
+  // a stricter limit than contact analysis's, nor faster than the library's largest rest speed:
+  // a jog's ball is still landing at half its speed), not while the heel strikes or rolls off;
   // it is kept through the contact while the ball is no faster than in 90% of those frames.
   // Toe heights and swing progress as for a gait clip.
   const FootTracks tracks = foot_tracks(lc.clip, sk);
@@ -523,7 +525,7 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk,
     lc.toe_speed_m_s[s] = ground;
     std::vector<float> rested;
     for (int f = 0; f < n; ++f) {
-      const float rest = still_speed_m_s((*speed)[f], ct);
+      const float rest = std::min(still_speed_m_s((*speed)[f], ct), max_rest_m_s);
       lc.plant[s][f] = contact[f] && ground[f] <= rest;
       if (lc.plant[s][f]) rested.push_back(ground[f]);
     }
@@ -1248,7 +1250,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   for (PendingTransition& p : pending) {
     Transition tr;
     tr.kind = p.kind;
-    LocomotionClip lc = make_transition_clip(p.span, sk, &tr.speed_m_s);
+    LocomotionClip lc = make_transition_clip(p.span, sk, &tr.speed_m_s, lib.max_rest_speed_m_s);
     tr.fps = lc.clip.fps;
     tr.duration_s = lc.clip.duration_s();
     const bool start = p.kind == TransitionKind::kStart;

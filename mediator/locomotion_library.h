@@ -142,9 +142,11 @@ struct LocomotionLibrary {
   // blend of a walk and a run keeps the walk the heavier (its feet and contacts): mediator_passes.
   float walk_run_speed_m_s = 2.0f;
   // A ball moving faster than this over the ground is not at rest, however fast the body goes:
-  // clip analysis's still speed (half the travel speed) at the walk-run speed of this skeleton's
-  // legs (Froude 0.5 on the leg length) [m/s]. A foot lock starts where the clip's ball rests; a
-  // runner's planted ball rests as a walker's does, and at half a run's speed it is still landing.
+  // clip analysis's still speed (half the travel speed) at Froude 0.5 on this skeleton's mean leg
+  // length, hip-knee-ankle (a little below walk_run_speed_m_s, which takes the hip's height over a
+  // planted ankle) [m/s]. A foot lock starts where the clip's ball rests; a runner's planted ball
+  // rests as a walker's does, and at half a run's speed it is still landing. Gait clips and the
+  // starts and stops cut from takes are both trimmed with it.
   float max_rest_speed_m_s = 1.0f;
   // Height of each toe joint when the foot is flat on the ground [m] (lowest over the gait clips):
   // planted feet are locked at this height.

@@ -789,7 +789,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const FootLockState other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
     in.other_locked = !letting_go && other == FootLockState::kLocked;
     in.walking = pl.gait_weight[slot] >= kGaitVoteWeight;
-    in.flight = in.walking && pl.double_support[slot] < 0.5f;
+    in.flight = !letting_go && in.walking && pl.double_support[slot] < 0.5f;
     const bool other_coming_down =
         pl.plant[1 - side][slot] >= 0.5f || pl.swing_progress[1 - side][slot] >= 0.5f;
     // The other foot is in the air and will come down: walking, coming down in the clips and not

@@ -30,7 +30,8 @@ struct Foot {
   FootLockParams params;
   glm::vec3 goal{0.0f}, anim{0.0f};
   bool started = false;
-  bool flight = false;  // the clips run
+  bool walking = false;  // the gait clips step the feet (a walk or a run)
+  bool flight = false;   // the clips run (no double support)
   glm::vec3 step(const glm::vec3& anim_toe, bool plant, bool hold, float progress = 0.0f,
                  bool other_locked = false, float still_speed = 0.0f, float clip_speed = -1.0f) {
     FootLockInput in;
@@ -42,7 +43,7 @@ struct Foot {
     in.hold = hold;
     in.swing_progress = progress;
     in.other_locked = other_locked;
-    in.walking = flight;
+    in.walking = walking || flight;
     in.flight = flight;
     in.floor_toe_m = kFloor;
     in.still_speed_m_s = still_speed;
@@ -90,6 +91,7 @@ TEST(FootLock, PlantedFootIsPinnedWhereItWasDrawnAndOnlyComesDown) {
 TEST(FootLock, InARunThePinnedBallRisesWithThePushOff) {
   for (const bool run : {false, true}) {
     Foot foot;
+    foot.walking = true;  // a walk's foot alone on the ground, or a run's
     foot.flight = run;
     foot.step({0.0f, kFloor, 0.0f}, true, true);
     ASSERT_EQ(foot.lock.state, FootLockState::kLocked);

@@ -116,6 +116,34 @@ TEST(Transitions, TheSubject16TakesGiveAStartAndAStop) {
   EXPECT_GE(stops, 1);
 }
 
+// The jog's sudden stop: its feet are pinned, as a gait clip's are, only where the ball rests over
+// the ground as a walker's does (LocomotionLibrary::max_rest_speed_m_s), not at half the jog's
+// speed, while it is still landing; every contact keeps frames to pin on.
+TEST(Transitions, ASuddenStopFromAJogPinsOnlyResting) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh");
+  auto lib = test::load_data_library({"clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh",
+                                      "clips/bvh/more/cmu_16_57_run_jog_sudden_stop_mrl30.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  ASSERT_GT(lib->max_rest_speed_m_s, 0.0f);
+  int stops = 0, pinned = 0;
+  for (const Transition& t : lib->transitions) {
+    if (t.kind != TransitionKind::kStop) continue;
+    ++stops;
+    const LocomotionClip& c = lib->clips[t.clip];
+    for (int s = 0; s < 2; ++s) {
+      ASSERT_EQ(c.toe_speed_m_s[s].size(), c.plant[s].size());
+      for (size_t f = 0; f < c.plant[s].size(); ++f) {
+        if (!c.plant[s][f]) continue;
+        ++pinned;
+        EXPECT_LE(c.toe_speed_m_s[s][f], lib->max_rest_speed_m_s) << c.clip.name << " " << f;
+      }
+    }
+  }
+  EXPECT_GE(stops, 1);
+  EXPECT_GT(pinned, 0);
+}
+
 // Each stop comes with its mirror image: the same stop ending on the other foot, so its first
 // landing is half a cycle of the gait away from the stop's own.
 TEST(Transitions, EveryStopHasAMirrorImageEndingOnTheOtherFoot) {
