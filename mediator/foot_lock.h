@@ -84,10 +84,11 @@ struct FootLockInput {
   // it back to the clip's foot, so a drift alone starts no re-planting step (a step would lift it
   // while the other foot may still be rolling down onto its ball: both off the ground).
   bool walking = false;
-  // The clips run (they have a flight phase, no double support): the foot pushes off on its toes
-  // into the air, not onto the other foot, and a pinned ball follows the clips' up as well as
-  // down all through the stance (held down while the clips rose, it was snatched up at the
-  // release: tried, gated to the push-off alone, the CMU run's slide and pops came back).
+  // The body runs (clips with a flight phase, no double support, at or above the walk-run speed;
+  // pose synthesis sets it): the foot pushes off on its toes into the air, not onto the other
+  // foot, and a pinned ball follows the clips' up as well as down all through the stance (held
+  // down while the clips rose, it was snatched up at the release: tried, gated to the push-off
+  // alone, the CMU run's slide and pops came back).
   bool flight = false;
   // The other foot is in the air and coming down (walking: in the clips and not pinned yet; or in
   // a re-planting step), or pinned on its heel and still rolling down onto its ball: this one

@@ -789,7 +789,12 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const FootLockState other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
     in.other_locked = !letting_go && other == FootLockState::kLocked;
     in.walking = pl.gait_weight[slot] >= kGaitVoteWeight;
-    in.flight = !letting_go && in.walking && pl.double_support[slot] < 0.5f;
+    // Running: clips with a flight phase, at a running speed. Below the walk-run speed a person
+    // walks (GAIT.md), whatever the clips (a jog slowed for walkers, blended with the standing
+    // pose, swings its feet low): the push-off is onto the other foot, and a pinned ball that
+    // rose with the clips' stayed above the swinging foot, which then slid along the floor.
+    in.flight = !letting_go && in.walking && pl.double_support[slot] < 0.5f &&
+                pl.speed_m_s[slot] >= library_.walk_run_speed_m_s;
     const bool other_coming_down =
         pl.plant[1 - side][slot] >= 0.5f || pl.swing_progress[1 - side][slot] >= 0.5f;
     // The other foot is in the air and will come down: walking, coming down in the clips and not
