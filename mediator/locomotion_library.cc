@@ -241,6 +241,13 @@ float stance_sweep_speed(const LocomotionClip& lc, const Skeleton& sk) {
 constexpr float kGravity = 9.81f;          // [m/s^2]
 constexpr float kTransitionFroude = 0.5f;  // walk-run transition (Alexander; GAIT.md's 2 m/s)
 
+// Where a clip's ball rests, so a lock may start: slower than contact analysis's still speed at
+// the body's travel speed, and than max_rest_m_s (LocomotionLibrary::max_rest_speed_m_s: a
+// runner's ball rests as a walker's does) [m/s]. Gait clips and transitions alike.
+float lock_rest_speed(float travel_m_s, float max_rest_m_s) {
+  return std::min(still_speed_m_s(travel_m_s), max_rest_m_s);
+}
+
 // max_rest_m_s: LocomotionLibrary::max_rest_speed_m_s.
 void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk, float max_rest_m_s) {
   // Each foot's contacts as clip analysis finds them.
@@ -291,7 +298,7 @@ void fill_contacts_and_heights(LocomotionClip* lc, const Skeleton& sk, float max
     // trimmed to where the ball rests. (Clips authored in place are judged by the direction their
     // stance foot is carried, not its speed over the ground, which keyframes need not keep.)
     if (!lc->analysis.in_place) {
-      const float rest = std::min(still_speed_m_s(glm::length(travel)), max_rest_m_s);
+      const float rest = lock_rest_speed(glm::length(travel), max_rest_m_s);
       std::vector<uint8_t>& pl = lc->plant[s];
       int first_free = -1;
       for (int f = 0; f < n && first_free < 0; ++f) {
@@ -508,7 +515,6 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk, std::v
   // Toe heights and swing progress as for a gait clip.
   const FootTracks tracks = foot_tracks(lc.clip, sk);
   const FootTracks world = foot_tracks(span, sk);  // with the take's root motion
-  const ContactThresholds ct;
   const std::vector<uint8_t> down[2] = {contact_frames(lc.analysis, 0, n, lc.clip.fps, false),
                                         contact_frames(lc.analysis, 1, n, lc.clip.fps, false)};
   for (int s = 0; s < 2; ++s) {
@@ -525,7 +531,7 @@ LocomotionClip make_transition_clip(const Clip& span, const Skeleton& sk, std::v
     lc.toe_speed_m_s[s] = ground;
     std::vector<float> rested;
     for (int f = 0; f < n; ++f) {
-      const float rest = std::min(still_speed_m_s((*speed)[f], ct), max_rest_m_s);
+      const float rest = lock_rest_speed((*speed)[f], max_rest_m_s);
       lc.plant[s][f] = contact[f] && ground[f] <= rest;
       if (lc.plant[s][f]) rested.push_back(ground[f]);
     }
