@@ -190,9 +190,21 @@ std::vector<float> gait_phase(const ClipAnalysis& a, float period_s, bool loops)
   for (const TimeInterval& c : a.contacts[1]) {
     if (c.start_s > first) m.push_back({c.start_s, 0.5f});
   }
-  std::sort(m.begin(), m.end(), [](const Marker& x, const Marker& y) { return x.t < y.t; });
   std::vector<float> phase(a.num_frames, 0.0f);
   if (m.empty() || period_s <= 0.0f) return phase;
+  if (loops && a.duration_s > 0.0f) {
+    // A loop's contacts come round again after its duration: its frames near the seam lie
+    // between a marker before it and one after, as everywhere else. (Carried past the last
+    // marker at the cycle's mean rate instead, the phase at the loop's end did not meet the
+    // phase at its start wherever the two steps of the stride differ in length, and a clip
+    // played by phase skipped or repeated frames at every wrap.)
+    const size_t own = m.size();
+    for (size_t k = 0; k < own; ++k) {
+      m.push_back({m[k].t - a.duration_s, m[k].phase});
+      m.push_back({m[k].t + a.duration_s, m[k].phase});
+    }
+  }
+  std::sort(m.begin(), m.end(), [](const Marker& x, const Marker& y) { return x.t < y.t; });
   // Unwrap marker phases so they increase by 0.5 per alternating step.
   std::vector<float> unwrapped(m.size());
   unwrapped[0] = m[0].phase;

@@ -45,6 +45,41 @@ TEST(LocomotionLibrary, BuiltinBlendSpace) {
   }
 }
 
+// A loop played by phase comes round to its first frame as its phase does: its phase table spans
+// a whole number of the loop's durations (one stride: the duration itself). Otherwise every wrap
+// of the phase skips (or repeats) the frames between, and the legs jump each stride. Loops cut
+// from captures have steps of unequal length, where the phase at the loop's end did not meet the
+// phase at its start (the CMU run, subject 16's veer, turn and fast walk were a frame short).
+TEST(LocomotionLibrary, LoopsPlayedByPhaseWrapWithoutSkippingFrames) {
+  GK_REQUIRE_DATA("clips/bvh/more");
+  auto cmu =
+      test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
+  auto more = test::subject16_library();
+  auto mannequin = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
+  ASSERT_TRUE(cmu.ok()) << cmu.message();
+  ASSERT_TRUE(more.ok()) << more.message();
+  ASSERT_TRUE(mannequin.ok()) << mannequin.message();
+  int loops = 0;
+  for (const LocomotionLibrary* lib : std::initializer_list<const LocomotionLibrary*>{
+           &test::builtin_library(), &*cmu, &*more, &*mannequin}) {
+    for (const LocomotionClip& c : lib->clips) {
+      if (!c.gait || !c.clip.loops) continue;
+      ++loops;
+      const float duration = c.clip.duration_s();
+      const float strides = std::max(1.0f, std::round(duration / c.cycle_s));
+      // Within a tenth of a frame.
+      EXPECT_NEAR(c.cycle_s * strides, duration, 0.1f / c.clip.fps) << c.clip.name;
+      // The phase advances through the seam as it does on either side of it: its last table
+      // step is no longer in clip time than twice the mean step.
+      const float mean_step = c.cycle_s / kPhaseTableSize;
+      EXPECT_LT(c.phase_to_time[kPhaseTableSize] - c.phase_to_time[kPhaseTableSize - 1],
+                2.0f * mean_step + 1e-4f)
+          << c.clip.name;
+    }
+  }
+  EXPECT_GE(loops, 20);
+}
+
 TEST(LocomotionLibrary, InPlaceClipsKeepOnlyTheSway) {
   // The in-place walk's hips stay within a few centimetres of the origin horizontally.
   const LocomotionLibrary& lib = test::builtin_library();
