@@ -54,7 +54,8 @@ struct ClipAnalysis {
   float direction_rad = 0.0f;  // travel direction relative to the character's facing (0 = forward)
   TimeInterval cycle;          // one gait cycle (the loop points of a one-stride loop)
   std::vector<TimeInterval> contacts[2];  // [Side] foot contact intervals, in clip time
-  // Per frame: gait phase in [0, 1), 0 at the left foot's contact start (linear between contacts).
+  // Per frame: gait phase in [0, 1), 0 at the left foot's contact start (linear between contacts;
+  // a loop's contacts come round again after its duration, so its phase runs on across the seam).
   std::vector<float> phase;
   SlideStats floor;  // foot-slide metrics of the clip played with its own root motion
   // Ground under the feet, fitted to the lowest toe heights: y = ground_y0_m + ground_slope_m_s *
