@@ -10,6 +10,7 @@
 
 #include "animation/clip_library.h"
 #include "animation/pose_jobs.h"
+#include "animation/procedural.h"
 #include "tests/mediator/mediator_fixture.h"
 #include "tests/test_data.h"
 
@@ -78,6 +79,56 @@ TEST(LocomotionLibrary, LoopsPlayedByPhaseWrapWithoutSkippingFrames) {
     }
   }
   EXPECT_GE(loops, 20);
+}
+
+// The same for a loop of any rig: the built-in walk, time-warped smoothly (the loop stays closed)
+// so that one of its steps takes longer than the other, as a capture's may.
+TEST(LocomotionLibrary, AnUnevenLoopWrapsWithoutSkippingFrames) {
+  ClipSet set = make_builtin_clip_set();
+  std::vector<Clip> kept;
+  for (const Clip& c : set.clips) {
+    if (c.name == "idle") kept.push_back(c);
+    if (c.name != "walk") continue;
+    Clip w = c;
+    const int n = c.num_frames, nj = c.num_joints;
+    constexpr float kTwoPi = 6.2831853f;
+    for (int k = 0; k < n; ++k) {
+      // Frame k of the warped loop shows the walk at frame s(k): s' = 1 + 0.35 cos(...) > 0.
+      const float x = static_cast<float>(k) / static_cast<float>(n);
+      const float s = static_cast<float>(n) * (x + 0.35f / kTwoPi * std::sin(kTwoPi * x + 1.0f) -
+                                               0.35f / kTwoPi * std::sin(1.0f));
+      const float fs = s - std::floor(s / static_cast<float>(n)) * static_cast<float>(n);
+      const int f0 = std::min(static_cast<int>(fs), n - 1), f1 = (f0 + 1) % n;
+      const float u = fs - static_cast<float>(f0);
+      for (int j = 0; j < nj; ++j) {
+        const size_t o = static_cast<size_t>(k) * nj + j;
+        w.rotations[o] = glm::slerp(c.frame_rotations(f0)[j], c.frame_rotations(f1)[j], u);
+        w.translations[o] = glm::mix(c.frame_translations(f0)[j], c.frame_translations(f1)[j], u);
+      }
+    }
+    kept.push_back(std::move(w));
+  }
+  ASSERT_EQ(kept.size(), 2u);
+  set.clips = std::move(kept);
+  auto lib = build_locomotion_library({set});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const LocomotionClip* walk = find(*lib, "walk");
+  ASSERT_NE(walk, nullptr);
+  ASSERT_TRUE(walk->gait);
+  // Its two steps are uneven: one contact start is not halfway round from the other.
+  const float l = walk->analysis.contacts[0][0].start_s, r = walk->analysis.contacts[1][0].start_s;
+  float apart = std::abs(r - l) / walk->clip.duration_s();
+  EXPECT_GT(std::abs(apart - 0.5f), 0.05f);
+  EXPECT_NEAR(walk->cycle_s, walk->clip.duration_s(), 0.1f / walk->clip.fps);
+  // Across the seam the phase moves on as much as a frame either side of it does.
+  const std::vector<float>& ph = walk->analysis.phase;
+  const int n = walk->clip.num_frames;
+  auto step = [&](int f) {
+    float d = ph[(f + 1) % n] - ph[f];
+    return d - std::floor(d);
+  };
+  const float around = 0.5f * (step(n - 2) + step(0));
+  EXPECT_NEAR(step(n - 1), around, 0.25f * around);
 }
 
 TEST(LocomotionLibrary, InPlaceClipsKeepOnlyTheSway) {
