@@ -41,25 +41,54 @@ inline Rig load_rig(const std::string& rel, const std::string& clip_name = "") {
 
 // --- Transforms -----------------------------------------------------------------------------
 
+// Frame k of `out` set to c at fractional frame f: rotations slerped, translations lerped between
+// the frames around it (a loop's last frame runs on into its first; a take's end is held).
+inline void sample_frame(const Clip& c, float f, Clip* out, int k) {
+  const int n = c.num_frames;
+  int i0, i1;
+  if (c.loops) {
+    f -= std::floor(f / static_cast<float>(n)) * static_cast<float>(n);
+    i0 = std::min(static_cast<int>(f), n - 1);
+    i1 = (i0 + 1) % n;
+  } else {
+    f = std::clamp(f, 0.0f, static_cast<float>(n - 1));
+    i0 = std::min(static_cast<int>(f), std::max(n - 2, 0));
+    i1 = std::min(i0 + 1, n - 1);
+  }
+  const float u = f - static_cast<float>(i0);
+  const int nj = c.num_joints;
+  for (int j = 0; j < nj; ++j) {
+    const size_t o = static_cast<size_t>(k) * nj + j;
+    out->rotations[o] = glm::slerp(c.frame_rotations(i0)[j], c.frame_rotations(i1)[j], u);
+    out->translations[o] = glm::mix(c.frame_translations(i0)[j], c.frame_translations(i1)[j], u);
+  }
+}
+
 // The take resampled at `fps` (translations lerped, rotations slerped between frames).
 inline Clip resampled(const Clip& c, float fps) {
   Clip out = c;
   out.fps = fps;
   const float span_s = (c.num_frames - 1) / c.fps;
   out.num_frames = static_cast<int>(std::floor(span_s * fps + 1e-4f)) + 1;
-  const int nj = c.num_joints;
-  out.rotations.resize(static_cast<size_t>(out.num_frames) * nj);
+  out.rotations.resize(static_cast<size_t>(out.num_frames) * c.num_joints);
   out.translations.resize(out.rotations.size());
-  for (int k = 0; k < out.num_frames; ++k) {
-    const float f = std::min(k / fps * c.fps, static_cast<float>(c.num_frames - 1));
-    const int i0 = std::min(static_cast<int>(f), c.num_frames - 2);
-    const float u = f - i0;
-    for (int j = 0; j < nj; ++j) {
-      const size_t o = static_cast<size_t>(k) * nj + j;
-      out.rotations[o] = glm::slerp(c.frame_rotations(i0)[j], c.frame_rotations(i0 + 1)[j], u);
-      out.translations[o] =
-          glm::mix(c.frame_translations(i0)[j], c.frame_translations(i0 + 1)[j], u);
-    }
+  for (int k = 0; k < out.num_frames; ++k) sample_frame(c, k / fps * c.fps, &out, k);
+  return out;
+}
+
+// A loop retimed smoothly, so that one part of it plays slower and the rest faster (by up to
+// `amount` of the mean pace, < 1), its frame count and duration kept and the loop still closed:
+// a walk whose two steps then differ in length, as a capture's may.
+inline Clip unevenly_timed(const Clip& loop, float amount) {
+  Clip out = loop;
+  const float n = static_cast<float>(loop.num_frames);
+  // Frame k shows the loop at frame s(k) = n (x + a/2pi (sin(2pi x + 1) - sin 1)), x = k / n:
+  // s' = n (1 + a cos(2pi x + 1)) > 0 for a < 1, and s(n) = n.
+  for (int k = 0; k < loop.num_frames; ++k) {
+    const float x = static_cast<float>(k) / n;
+    const float s =
+        n * (x + amount / (2.0f * kPi) * (std::sin(2.0f * kPi * x + 1.0f) - std::sin(1.0f)));
+    sample_frame(loop, s, &out, k);
   }
   return out;
 }

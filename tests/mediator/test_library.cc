@@ -11,6 +11,7 @@
 #include "animation/clip_library.h"
 #include "animation/pose_jobs.h"
 #include "animation/procedural.h"
+#include "tests/animation/clip_transforms.h"
 #include "tests/mediator/mediator_fixture.h"
 #include "tests/test_data.h"
 
@@ -88,25 +89,7 @@ TEST(LocomotionLibrary, AnUnevenLoopWrapsWithoutSkippingFrames) {
   std::vector<Clip> kept;
   for (const Clip& c : set.clips) {
     if (c.name == "idle") kept.push_back(c);
-    if (c.name != "walk") continue;
-    Clip w = c;
-    const int n = c.num_frames, nj = c.num_joints;
-    constexpr float kTwoPi = 6.2831853f;
-    for (int k = 0; k < n; ++k) {
-      // Frame k of the warped loop shows the walk at frame s(k): s' = 1 + 0.35 cos(...) > 0.
-      const float x = static_cast<float>(k) / static_cast<float>(n);
-      const float s = static_cast<float>(n) * (x + 0.35f / kTwoPi * std::sin(kTwoPi * x + 1.0f) -
-                                               0.35f / kTwoPi * std::sin(1.0f));
-      const float fs = s - std::floor(s / static_cast<float>(n)) * static_cast<float>(n);
-      const int f0 = std::min(static_cast<int>(fs), n - 1), f1 = (f0 + 1) % n;
-      const float u = fs - static_cast<float>(f0);
-      for (int j = 0; j < nj; ++j) {
-        const size_t o = static_cast<size_t>(k) * nj + j;
-        w.rotations[o] = glm::slerp(c.frame_rotations(f0)[j], c.frame_rotations(f1)[j], u);
-        w.translations[o] = glm::mix(c.frame_translations(f0)[j], c.frame_translations(f1)[j], u);
-      }
-    }
-    kept.push_back(std::move(w));
+    if (c.name == "walk") kept.push_back(test::unevenly_timed(c, 0.35f));
   }
   ASSERT_EQ(kept.size(), 2u);
   set.clips = std::move(kept);
@@ -117,7 +100,7 @@ TEST(LocomotionLibrary, AnUnevenLoopWrapsWithoutSkippingFrames) {
   ASSERT_TRUE(walk->gait);
   // Its two steps are uneven: one contact start is not halfway round from the other.
   const float l = walk->analysis.contacts[0][0].start_s, r = walk->analysis.contacts[1][0].start_s;
-  float apart = std::abs(r - l) / walk->clip.duration_s();
+  const float apart = std::abs(r - l) / walk->clip.duration_s();
   EXPECT_GT(std::abs(apart - 0.5f), 0.05f);
   EXPECT_NEAR(walk->cycle_s, walk->clip.duration_s(), 0.1f / walk->clip.fps);
   // Across the seam the phase moves on as much as a frame either side of it does.
