@@ -259,19 +259,31 @@ glm::vec3 releasing_foot(FootLock& s, const FootLockInput& in, const FootLockPar
 // clips' own swing: the foot rises before it moves and stops moving before it lands (zero speed at
 // both ends, so nothing snaps). Landed, it is pinned there.
 glm::vec3 stepping_foot(FootLock& s, const FootLockInput& in, const FootLockParams& p, float dt) {
+  const bool first = s.timer_s <= 0.0f;
   s.timer_s += dt;
   const float u = std::min(1.0f, s.timer_s / p.step_time_s);
   const float sn = std::sin(std::numbers::pi_v<float> * u);
   glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
   // Where it lands is chosen before it comes down: it follows the clip's foot while it is
   // carried, and is set down on the spot it was carried to (a body turning on the spot would
-  // otherwise drag the landing foot along the ground).
-  if (u < 1.0f - kStepLift) {
-    s.step_to = to;
-  } else {
-    to.x = s.step_to.x;
-    to.z = s.step_to.z;
+  // otherwise drag the landing foot along the ground). Where the clip's foot jumps (a blend
+  // changing under it: a walk fading in moves it back by centimetres a frame) it is followed on a
+  // critically damped spring of a glide's halflife: a step aimed at it directly reversed in a
+  // frame, snapping the ankle.
+  if (first) {
+    s.step_to = glm::vec3(to.x, 0.0f, to.z);
+    s.step_to_vel = glm::vec3(0.0f);
+  } else if (u < 1.0f - kStepLift) {
+    // The clip's foot carried with the body (no faster than twice the still speed, the body's own)
+    // is followed as it goes; what it moves beyond that, a blend changing, on the spring.
+    glm::vec3 carried(in.anim_toe.x - in.anim_toe_prev.x, 0.0f, in.anim_toe.z - in.anim_toe_prev.z);
+    const float most = 2.0f * in.still_speed_m_s * dt, len = glm::length(carried);
+    if (len > most) carried *= most / len;
+    s.step_to += carried;
+    critical_spring(s.step_to, s.step_to_vel, glm::vec3(to.x, 0.0f, to.z), p.glide_halflife_s, dt);
   }
+  to.x = s.step_to.x;
+  to.z = s.step_to.z;
   glm::vec3 goal = glm::mix(s.from, to, smoothstep01((u - kStepLift) / (1.0f - 2.0f * kStepLift)));
   goal.y = glm::mix(s.from.y, to.y, smoothstep01(u)) + p.step_height_m * sn * sn;
   if (u >= 1.0f) {

@@ -52,6 +52,7 @@ struct FootLock {
   glm::vec3 from{0.0f};         // stepping: where the step started [m]
   float timer_s = 0.0f;         // stepping: time since the step started [s]
   glm::vec3 step_to{0.0f};      // stepping: where it is set down (chosen as it starts to lower) [m]
+  glm::vec3 step_to_vel{0.0f};  // stepping: its rate [m/s] (it follows the clip's foot on a spring)
   glm::vec3 last_goal{0.0f};    // the goal returned last frame [m]
   glm::vec3 goal_vel{0.0f};     // its velocity [m/s] (a step turned release keeps its speed)
   float shed = 0.0f;            // releasing: share of the release offset shed so far, 0..1

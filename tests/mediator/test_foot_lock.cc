@@ -568,6 +568,38 @@ TEST(FootLock, StepSetsTheFootDownWhereItWasCarried) {
   EXPECT_NEAR(horizontal(foot.step(anim, false, true), landed), 0.0f, 1e-6f);
 }
 
+// A re-planting step while the clip's foot jumps back under it mid-carry, as it does when a walk
+// fades in over a standing blend (4.6 cm a frame in a DetourCrowd jam with the CMU clips): the step
+// still follows most of it, but its goal never turns harder than the step itself does
+// toward a clip foot that moves steadily. Aimed at the clip's foot directly, the step's velocity
+// reversed in a frame and the ankle snapped.
+TEST(FootLock, StepAimsAtAClipFootThatJumpsWithoutSnapping) {
+  // The largest horizontal acceleration of the goal over the step, and where the foot landed.
+  auto run = [](float jump_m) {
+    Foot foot;
+    glm::vec3 anim(0.0f, kFloor, 0.0f);
+    foot.step(anim, true, true);
+    foot.lock = start_foot_step(foot.lock, glm::vec3(-0.3f, kFloor, 0.0f));
+    foot.goal = glm::vec3(-0.3f, kFloor, 0.0f);
+    std::vector<glm::vec3> goals{foot.goal};
+    for (int k = 1; k <= 40 && foot.lock.state == FootLockState::kStepping; ++k) {
+      anim.x += 0.3f * kDt;                            // the body drifts on at 0.3 m/s
+      if (k >= 12 && k < 15) anim.x -= jump_m / 3.0f;  // the blend moves the clip's foot back
+      goals.push_back(foot.step(anim, false, true, 0.0f, false, /*still_speed=*/0.2f));
+    }
+    float most = 0.0f;
+    for (size_t i = 2; i < goals.size(); ++i) {
+      const glm::vec3 a = (goals[i] - 2.0f * goals[i - 1] + goals[i - 2]) / (kDt * kDt);
+      most = std::max(most, std::hypot(a.x, a.z));
+    }
+    return std::pair{most, foot.lock.state == FootLockState::kLocked ? foot.goal.x - anim.x : 1e9f};
+  };
+  const auto [steady_accel, steady_miss] = run(0.0f);
+  const auto [jump_accel, jump_miss] = run(0.14f);
+  EXPECT_NEAR(jump_miss, steady_miss, 0.25f * 0.14f);  // most of the jump followed
+  EXPECT_LE(jump_accel, 1.5f * steady_accel) << steady_accel;
+}
+
 // Released 0.75 m from a clip toe that stands still (a foot left behind in a jam): with the
 // clips' swing speed given, the foot is carried at no more than that speed; without it, the
 // release's shortest time (twice the halflife) would carry it at several times that.
