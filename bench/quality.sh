@@ -5,22 +5,36 @@
 # with the METRICS.md v1 and v2 columns (v2 floors of the library's own clips in brackets). Writes a Markdown table (stdout, and
 # bench/quality.md unless QUALITY_OUT is set) and keeps every JSON report in $QUALITY_DIR.
 # QUALITY_ARGS adds arguments to every run (e.g. "--set max_playback_rate=1.5").
-# Usage: bench/quality.sh [--frames F] [--agents N]   (needs jq and a built ./build/app/gaitkeeper)
+# --takes: libraries of one take each instead (every BVH of clips/bvh/more and the two CMU clips,
+# each alone, as a user who brings a single clip has it); writes bench/takes.md and keeps the JSON
+# in build/takes unless QUALITY_OUT / QUALITY_DIR say otherwise.
+# Below the table: per library, how many of the METRICS.md v2 apm bounds of the metrics-v2 issue
+# its apm runs meet (support slide <= 2 cm/s, support skate <= 0.005, gmd skate <= the clips'
+# own + 0.002, float <= 0.01, penetration p99 <= 0.5 and max <= 1.5 cm, limb pops <= 1 per
+# agent-minute, naive's support slide at least 10 times apm's), and the total.
+# Usage: bench/quality.sh [--frames F] [--agents N] [--takes]   (needs jq and a built ./build/app/gaitkeeper)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 gk=${GAITKEEPER:-./build/app/gaitkeeper}
 data=${GAITKEEPER_DATA:-$(cd .. && pwd)/shared/data}
 frames=600
 agents=""
+takes=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --frames) frames=$2; shift 2 ;;
     --agents) agents="--agents $2"; shift 2 ;;
+    --takes) takes=1; shift ;;
     *) echo "quality.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
-out=${QUALITY_OUT:-bench/quality.md}
-dir=${QUALITY_DIR:-build/quality}
+if ((takes)); then
+  out=${QUALITY_OUT:-bench/takes.md}
+  dir=${QUALITY_DIR:-build/takes}
+else
+  out=${QUALITY_OUT:-bench/quality.md}
+  dir=${QUALITY_DIR:-build/quality}
+fi
 mkdir -p "$dir"
 command -v jq >/dev/null || { echo "quality.sh: needs jq (apt-get install jq)" >&2; exit 2; }
 [[ -x $gk ]] || { echo "quality.sh: $gk not built (run scripts/setup.sh)" >&2; exit 2; }
@@ -31,6 +45,17 @@ declare -A clipsets=(
   [cmu]="--clips $data/clips/bvh/cmu_07_01_walk.bvh $data/clips/bvh/cmu_09_11_run.bvh"
   [more]="--clips $data/clips/bvh/more"
 )
+libraries=(builtin mannequin cmu more)
+if ((takes)); then
+  clipsets=()
+  libraries=()
+  for f in "$data"/clips/bvh/more/*.bvh "$data"/clips/bvh/cmu_07_01_walk.bvh "$data"/clips/bvh/cmu_09_11_run.bvh; do
+    [[ -f $f ]] || { echo "quality.sh: $f not found (GAITKEEPER_DATA?)" >&2; exit 2; }
+    take=$(basename "$f" .bvh)
+    clipsets[$take]="--clips $f"
+    libraries+=("$take")
+  done
+fi
 runs=()
 # Every built-in scenario (data/scenarios/*.json), the six of the demo first.
 scenarios=(corridor crossing circle bottleneck plaza gallery)
@@ -55,11 +80,11 @@ done
   echo "| scenario | sim | clips | mode | slide cm/s (floor) | skate | support slide cm/s [floor] | support skate | gmd skate [floor] | float | penetration p99/max cm | limb pops /agent-min [floor] | torsion max | facing p95 | heading p95 | root mean/max cm | rate outside | pops | naive/apm support slide |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$out.tmp"
-total=$(( ${#runs[@]} * 4 * 2 ))
+total=$(( ${#runs[@]} * ${#libraries[@]} * 2 ))
 k=0
 for run in "${runs[@]}"; do
   IFS='|' read -r name args sim <<<"$run"
-  for cs in builtin mannequin cmu more; do
+  for cs in "${libraries[@]}"; do
     declare -A slide=()
     for mode in naive apm; do
       k=$((k + 1))
@@ -84,5 +109,37 @@ for run in "${runs[@]}"; do
     done
   done
 done
+# How many of the v2 apm bounds one apm run meets (of 7), against its naive run.
+checks_met() {
+  jq -n --slurpfile a "$1" --slurpfile n "$2" '
+    $a[0].metrics as $m | ($n[0].metrics.support_slide_cm_s // 0) as $ns |
+    [$m.support_slide_cm_s <= 2.0, $m.support_skate_ratio <= 0.005,
+     $m.gmd_skate_ratio <= $m.feet_floor.gmd_skate_ratio + 0.002, $m.float_ratio <= 0.01,
+     ($m.penetration_cm.p99 <= 0.5 and $m.penetration_cm.max <= 1.5), $m.limb_pop_rate <= 1.0,
+     $ns >= 10 * $m.support_slide_cm_s] | map(select(.)) | length'
+}
+{
+  echo
+  echo "| library | apm runs | v2 apm bounds met |"
+  echo "|---|---|---|"
+} >> "$out.tmp"
+all_met=0
+all_checks=0
+for cs in "${libraries[@]}"; do
+  met=0
+  n=0
+  for run in "${runs[@]}"; do
+    IFS='|' read -r name args sim <<<"$run"
+    a="$dir/${name}_${sim}_${cs}_apm.json"
+    nv="$dir/${name}_${sim}_${cs}_naive.json"
+    n=$((n + 1))
+    [[ -s $a && -s $nv ]] || continue  # a failed run meets none
+    met=$((met + $(checks_met "$a" "$nv")))
+  done
+  echo "| $cs | $n | $met of $((n * 7)) |" >> "$out.tmp"
+  all_met=$((all_met + met))
+  all_checks=$((all_checks + n * 7))
+done
+echo "| all | $(( ${#runs[@]} * ${#libraries[@]} )) | $all_met of $all_checks |" >> "$out.tmp"
 mv "$out.tmp" "$out"
 cat "$out"
