@@ -459,8 +459,9 @@ void rate_phase_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
   const MediatorParams& P = c.params;
   for_each_agent(c, [&](size_t, int slot) {
     const float dt = c.dt(slot);
-    // Playback rate from speed, within limits; the rest is stride warping (foot IK), beyond that
-    // the deliverable speed goes back to the simulator (feedback).
+    // Playback rate from speed, within limits; beyond them the deliverable speed goes back to
+    // the simulator (feedback_pass, with the stride stretch MediatorParams::max_stride_warp
+    // allows, none by default).
     const int16_t* lc = &layer_clip[slot * kMaxBlendLayers];
     const float* lw = &layer_weight[slot * kMaxBlendLayers];
     const GaitFrequency gf = gait_frequency(lib, lc, lw);
