@@ -412,6 +412,7 @@ Result<ClipSet> parse_bvh(std::string_view text, const std::string& source_name,
   GK_RETURN_IF_ERROR(clip);
   clip->name = internal::file_stem(source_name);
   clip->source = source_name;
+  set.up_reason = internal::stand_up_along_y(skeleton.get(), &clip.value());
   internal::finalize_loop(&clip.value(), *skeleton, internal::loop_tolerance_m(*skeleton));
   GK_RETURN_IF_ERROR(validate_clip(*clip, *skeleton));
   set.clips.push_back(std::move(clip).value());

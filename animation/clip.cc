@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtx/quaternion.hpp>
@@ -105,6 +106,90 @@ float loop_tolerance_m(const Skeleton& skeleton) {
   }
   if (sides == 0 || !(leg > 0.0f)) return 0.05f;
   return 0.06f * leg / sides;
+}
+
+namespace {
+
+// The axis (0 x, 1 y, 2 z) and sign nearest `v`, or axis -1 where v is within 37 degrees of none
+// (or has no length).
+struct NearestAxis {
+  int axis = -1;
+  float sign = 1.0f;
+};
+NearestAxis nearest_axis(const glm::vec3& v) {
+  const float len = glm::length(v);
+  if (!(len > 1e-6f) || !std::isfinite(len)) return {};
+  int k = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (std::abs(v[i]) > std::abs(v[k])) k = i;
+  }
+  if (std::abs(v[k]) < 0.8f * len) return {};
+  return {k, v[k] < 0.0f ? -1.0f : 1.0f};
+}
+
+std::string axis_name(const NearestAxis& a) {
+  return std::string(a.sign < 0.0f ? "-" : "+") + static_cast<char>('x' + a.axis);
+}
+
+// Feet to head in a model-space pose (zero where the roles are missing).
+glm::vec3 body_up(const Skeleton& sk, const std::vector<glm::mat4>& model) {
+  int top = -1;
+  for (JointRole r : {JointRole::kHead, JointRole::kNeck, JointRole::kChest}) {
+    if (top < 0) top = sk.role(r);
+  }
+  glm::vec3 feet(0.0f);
+  int n = 0;
+  for (Side s : {Side::kLeft, Side::kRight}) {
+    const int f = sk.ankle(s) >= 0 ? sk.ankle(s) : sk.toe(s);
+    if (f < 0) continue;
+    feet += glm::vec3(model[f][3]);
+    ++n;
+  }
+  if (top < 0 || n == 0) return glm::vec3(0.0f);
+  return glm::vec3(model[top][3]) - feet / static_cast<float>(n);
+}
+
+}  // namespace
+
+std::string stand_up_along_y(Skeleton* sk, Clip* clip) {
+  std::vector<glm::mat4> model;
+  local_to_model(*sk, sk->rest_rotations.data(), sk->rest_translations.data(), &model);
+  const NearestAxis rest = nearest_axis(body_up(*sk, model));
+  // The motion's up: feet to head, each frame's direction averaged over up to 64 frames.
+  glm::vec3 sum(0.0f);
+  const int step = std::max(1, clip->num_frames / 64);
+  for (int f = 0; f < clip->num_frames; f += step) {
+    local_to_model(*sk, clip->frame_rotations(f), clip->frame_translations(f), &model);
+    const glm::vec3 v = body_up(*sk, model);
+    const float len = glm::length(v);
+    if (len > 1e-6f && std::isfinite(len)) sum += v / len;
+  }
+  const NearestAxis motion = nearest_axis(sum);
+  if (rest.axis < 0 && motion.axis < 0) {
+    return "+y (taken: no feet-to-head axis found in the rest pose or the motion)";
+  }
+  const bool motion_y = motion.axis == 1 && motion.sign > 0.0f;
+  if (motion_y) return "+y (the motion stands along +y)";
+  const NearestAxis up = rest.axis >= 0 ? rest : motion;
+  if (up.axis == 1 && up.sign > 0.0f) return "+y (the rest pose stands along +y)";
+  glm::vec3 from(0.0f);
+  from[up.axis] = up.sign;
+  const glm::vec3 to(0.0f, 1.0f, 0.0f);
+  const glm::quat turn =
+      up.axis == 1 ? glm::angleAxis(std::numbers::pi_v<float>, glm::vec3(1.0f, 0.0f, 0.0f))
+                   : glm::rotation(from, to);
+  for (int j = 0; j < sk->num_joints(); ++j) {
+    if (sk->parents[j] >= 0) continue;
+    sk->rest_translations[j] = turn * sk->rest_translations[j];
+    sk->rest_rotations[j] = glm::normalize(turn * sk->rest_rotations[j]);
+    for (int f = 0; f < clip->num_frames; ++f) {
+      const size_t o = static_cast<size_t>(f) * clip->num_joints + j;
+      clip->rotations[o] = glm::normalize(turn * clip->rotations[o]);
+      clip->translations[o] = turn * clip->translations[o];
+    }
+  }
+  return axis_name(up) + ": turned to stand along +y (the " +
+         (rest.axis >= 0 ? "rest pose" : "motion") + " stands along " + axis_name(up) + ")";
 }
 
 std::string file_name(const std::string& path) {

@@ -51,6 +51,9 @@ struct ClipSet {
   std::string scale_reason;                 // how it was chosen ("detected: centimetres", ...)
   // IK-style feet re-parented under their shins at load (attach_ik_feet), or empty.
   std::string rig_reason;
+  // Which way the source's body stands and whether it was turned to stand along +y (BVH from a
+  // Z-up or X-up tool: internal::stand_up_along_y); empty where the format fixes it (glTF).
+  std::string up_reason;
   std::string source;
 };
 

@@ -30,6 +30,15 @@ void finalize_loop(Clip* clip, const Skeleton& skeleton, float tolerance_m);
 // that travel and end mid-stride do not.
 float loop_tolerance_m(const Skeleton& skeleton);
 
+// Turns a take authored with another up axis (a Z-up or X-up tool) to stand along +y: every
+// root's rest transform and per-frame transform are turned by the shortest rotation that takes
+// the body's up axis to +y, so every joint keeps its place relative to the others. The body's up
+// is the axis nearest the direction from the feet (ankles or toes) to the head (or neck, chest)
+// in the rest pose, where that is within 37 degrees of an axis; a take whose motion stands along
+// +y throughout is never turned (a rest pose authored lying down), nor one without those roles.
+// Returns what was found and done ("+z: turned to stand along +y ..."), for ClipSet::up_reason.
+std::string stand_up_along_y(Skeleton* skeleton, Clip* clip);
+
 // File name without folders and extension ("walk" for "/a/walk.bvh").
 std::string file_stem(const std::string& path);
 // File name without folders ("walk.bvh").

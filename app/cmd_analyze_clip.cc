@@ -95,6 +95,7 @@ nlohmann::json analysis_json(const ClipSet& set, const Clip& clip, const ClipAna
       {"scale", set.scale_m_per_unit},
       {"scale_reason", set.scale_reason},
       {"rig", set.rig_reason},
+      {"up", set.up_reason},
       {"in_place", a.in_place},
       {"native_speed_m_s", a.native_speed_m_s},
       {"direction_deg", a.direction_rad * 180.0f / std::numbers::pi_v<float>},
@@ -116,6 +117,9 @@ void print_text(const nlohmann::json& j) {
               j["joints"].get<int>(), j["scale"].get<double>(),
               j["scale_reason"].get<std::string>().c_str(),
               j["loops"].get<bool>() ? ", loops" : "");
+  if (!j["up"].get<std::string>().empty()) {
+    std::printf("  up: %s\n", j["up"].get<std::string>().c_str());
+  }
   if (!j["rig"].get<std::string>().empty()) {
     std::printf("  rig: %s\n", j["rig"].get<std::string>().c_str());
   }

@@ -105,6 +105,25 @@ inline void move_take(Clip* c, const Skeleton& sk, const glm::quat& q, const glm
   }
 }
 
+// The take as a tool with another up axis would author it: the whole world turned by `up`
+// (angleAxis(90 deg, x) takes +y to +z: a Z-up file), rest offsets included, every joint's
+// rotation expressed in the turned axes, so every joint's position is `up` times the original's.
+inline Rig authored_turned(const Rig& in, const glm::quat& up) {
+  auto sk = std::make_shared<Skeleton>(*in.sk);
+  const glm::quat inv = glm::inverse(up);
+  for (size_t j = 0; j < sk->rest_translations.size(); ++j) {
+    sk->rest_translations[j] = up * sk->rest_translations[j];
+    sk->rest_rotations[j] = glm::normalize(up * sk->rest_rotations[j] * inv);
+    if (j < sk->end_sites.size()) sk->end_sites[j] = up * sk->end_sites[j];
+  }
+  Rig out{sk, in.clip};
+  for (size_t o = 0; o < out.clip.rotations.size(); ++o) {
+    out.clip.rotations[o] = glm::normalize(up * out.clip.rotations[o] * inv);
+    out.clip.translations[o] = up * out.clip.translations[o];
+  }
+  return out;
+}
+
 // The root raised by `rise_m` * (frame / last frame): a floor that drifts up over the take.
 inline void raise_over_take(Clip* c, float rise_m) {
   for (int f = 0; f < c->num_frames; ++f) {
