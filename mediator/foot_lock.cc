@@ -130,9 +130,9 @@ void release(FootLock& s, glm::vec3 drawn_toe, glm::vec3 drawn_vel, glm::vec3 an
 }
 
 // This frame's transition from the state the foot was in. speed and last_speed are the clip's toe
-// speed over the ground this frame and last (< 0: none).
+// speed over the ground this frame and last (< 0: none); dt the frame's time step [s] (> 0).
 void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
-                const glm::vec3& anim_vel, float speed, float last_speed) {
+                const glm::vec3& anim_vel, float speed, float last_speed, float dt) {
   switch (s.state) {
     case FootLockState::kFree:
     case FootLockState::kReleasing: {
@@ -166,9 +166,18 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
         // Released from rest: the offset is taken against where the clip's toe was last frame,
         // and the foot's rest against the clip's speed is carried on and shed (inertialization),
         // so the drawn foot sets off from rest: taking the clip's lift-off speed at once, the
-        // knee of a leg stretched to its pin would snap.
+        // knee of a leg stretched to its pin would snap. A pin that rises with the clip's toe
+        // (pin_height: a run's ball rising into the push-off) is taken as it was last frame too:
+        // raised to this frame's height first, it then rose by the clip's rise once more, twice
+        // the clip's in the release's frame (a ball snatched up 4 cm in a frame at a run's
+        // push-off).
+        // It sets off at the speed it was rising.
+        const glm::vec3 was = s.target + s.offset;
         pin_height(s, in);
-        release(s, s.target + s.offset, glm::vec3(0.0f), in.anim_toe_prev, anim_vel);
+        glm::vec3 drawn = s.target + s.offset;
+        const float rise = std::max(0.0f, drawn.y - was.y);
+        drawn.y = std::min(drawn.y, was.y);
+        release(s, drawn, glm::vec3(0.0f, rise / dt, 0.0f), in.anim_toe_prev, anim_vel);
         return;
       }
       // A foot left behind by a turn or a drift while the clips stand re-plants with a short step,
@@ -344,7 +353,7 @@ glm::vec3 advance_foot_lock(FootLock& s, const FootLockInput& raw, const FootLoc
   const float last_speed = s.anim_speed;
   s.anim_speed = in.fresh ? -1.0f : speed;
 
-  transition(s, in, p, anim_vel, speed, last_speed);
+  transition(s, in, p, anim_vel, speed, last_speed, dt);
   if (s.state != FootLockState::kReleasing) decay_offset(s, p, dt);
   glm::vec3 goal = in.anim_toe;
   switch (s.state) {

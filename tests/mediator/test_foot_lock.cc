@@ -108,15 +108,17 @@ TEST(FootLock, InARunThePinnedBallRisesWithThePushOff) {
       EXPECT_NEAR(highest, kFloor, 1e-6f);  // stays down: the heel rises about it
     }
     // Released as the clip's ball goes on rising at 5 mm a frame (0.3 m/s): the run's drawn ball
-    // goes on with it (the release's first frame lifts it by two frames' rise at most), the walk's
-    // catches up the whole push-off over the release, never at once.
+    // goes on with it, a frame's rise a frame (the release's first frame used to lift it by two:
+    // the pin raised to this frame's height, then the clip's rise once more, a 4 cm jump at a
+    // captured run's push-off), the walk's catches up the whole push-off over the release, never
+    // at once.
     float prev = highest, most = 0.0f;
     for (int f = 9; f <= 12; ++f) {
       const glm::vec3 g = foot.step({0.0f, kFloor + 0.005f * f, 0.0f}, false, false, 0.1f);
       most = std::max(most, g.y - prev);
       prev = g.y;
     }
-    EXPECT_LT(most, run ? 0.0101f : 0.03f) << run;
+    EXPECT_LT(most, run ? 0.0051f : 0.03f) << run;
   }
 }
 
