@@ -433,9 +433,14 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
     }
     // 2. Closing the loop: frame len must become frame 0 again. Each joint's mismatch is taken up
     //    gradually: a leg's joints only while that foot swings (a planted foot never moves for
-    //    it), the rest of the body over the whole stride.
+    //    it), the rest of the body over the whole stride. A leg's mismatch is taken up in its
+    //    longest swing, from none to all of it (frame len is frame 0 with all of it) or from all of
+    //    it taken back (frame 0 is frame len with none of it) to none: whichever leaves the fewer
+    //    stance frames changed. A stance between the swing and the seam must carry the mismatch
+    //    (or its inverse) to keep the seam closed; one on the other side never does.
     const std::vector<int> leg = leg_sides(sk);
     int swing_from[2] = {0, 0}, swing_to[2] = {len, len};
+    float before[2] = {0.0f, 0.0f};  // the share of the mismatch before the swing (0 or -1)
     for (int s = 0; s < 2; ++s) {
       std::vector<uint8_t> down(len + 1, 0);
       for (const TimeInterval& iv : an.contacts[s]) {
@@ -458,19 +463,28 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
         }
         k = e + 1;
       }
+      int stance_before = 0, stance_after = 0;  // frames 1..len-1 (0 and len are the seam)
+      for (int k = 1; k < len; ++k) {
+        stance_before += down[k] && k < swing_from[s];
+        stance_after += down[k] && k >= swing_to[s];
+      }
+      if (stance_before < stance_after) before[s] = -1.0f;
     }
     for (int j = 0; j < nj; ++j) {
       glm::quat diff = R(0, j) * glm::inverse(R(len, j));
       if (diff.w < 0.0f) diff = -diff;
       const glm::vec3 dt = T(0, j) - T(len, j);
-      for (int k = 1; k <= len; ++k) {
+      for (int k = leg[j] >= 0 ? 0 : 1; k <= len; ++k) {
         float w = static_cast<float>(k) / len;
         if (leg[j] >= 0) {
           const int s = leg[j];
-          w = smooth01(static_cast<float>(k - swing_from[s]) /
-                     std::max(1, swing_to[s] - swing_from[s]));
+          w = before[s] + smooth01(static_cast<float>(k - swing_from[s]) /
+                                   std::max(1, swing_to[s] - swing_from[s]));
         }
-        R(k, j) = glm::normalize(glm::slerp(glm::quat(1, 0, 0, 0), diff, w) * R(k, j));
+        if (w == 0.0f) continue;
+        const glm::quat turn = w > 0.0f ? glm::slerp(glm::quat(1, 0, 0, 0), diff, w)
+                                        : glm::slerp(glm::quat(1, 0, 0, 0), glm::inverse(diff), -w);
+        R(k, j) = glm::normalize(turn * R(k, j));
         if (j == 0) {
           T(k, j).y += w * dt.y;  // the root's travel stays its own; its height closes
         } else {

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The quality matrix of the mediator: every built-in scenario (data/scenarios) on both simulators and every
 # trajectory file in the shared data (the Social-GAN .txt files and ETH's original obsmat.txt), with the built-in clips, the mannequin glTF clips, the two
-# CMU clips and the CMU subject-16 set (clips/bvh/more), in naive and apm modes, 60 Hz, 600 frames,
+# CMU clips, the CMU subject-16 set (clips/bvh/more) and that set mixed with the two CMU clips
+# (another skeleton, retargeted by joint role), in naive and apm modes, 60 Hz, 600 frames,
 # with the METRICS.md v1 and v2 columns (v2 floors of the library's own clips in brackets). Writes a Markdown table (stdout, and
 # bench/quality.md unless QUALITY_OUT is set) and keeps every JSON report in $QUALITY_DIR.
 # QUALITY_ARGS adds arguments to every run (e.g. "--set max_playback_rate=1.5").
@@ -44,8 +45,9 @@ declare -A clipsets=(
   [mannequin]="--clips $data/clips/gltf/ual_mannequin_quaternius.glb"
   [cmu]="--clips $data/clips/bvh/cmu_07_01_walk.bvh $data/clips/bvh/cmu_09_11_run.bvh"
   [more]="--clips $data/clips/bvh/more"
+  [mixed]="--clips $data/clips/bvh/more $data/clips/bvh/cmu_07_01_walk.bvh $data/clips/bvh/cmu_09_11_run.bvh"
 )
-libraries=(builtin mannequin cmu more)
+libraries=(builtin mannequin cmu more mixed)
 if ((takes)); then
   clipsets=()
   libraries=()

@@ -185,6 +185,68 @@ TEST(Segmentation, LoopSeamIsNoBiggerThanTheTakesSteps) {
   }
 }
 
+// Closing a loop never bends a leg that bears weight where it need not: through every stance that
+// lies inside the stride (a run's other foot, down between two swings), that leg's knee in the
+// cut-out cycle bends exactly as much as in the take (the closing is taken up while the foot
+// swings). Held straight in the take, a running knee was bent backwards by 11 degrees in a cycle
+// whose longer swing came before that stance. Returns the frames checked.
+float knee_angle_deg(const std::vector<glm::mat4>& m, const Skeleton& sk, Side s) {
+  const glm::vec3 h = translation_of(m[sk.hip(s)]), k = translation_of(m[sk.knee(s)]),
+                  a = translation_of(m[sk.ankle(s)]);
+  const float c = glm::dot(glm::normalize(k - h), glm::normalize(a - k));
+  return std::acos(std::clamp(c, -1.0f, 1.0f)) * kDeg;
+}
+
+int expect_stance_knees_kept(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
+                             const Clip& loop, int a, const std::string& what) {
+  std::vector<glm::mat4> mt(sk.num_joints()), ml(sk.num_joints());
+  int checked = 0;
+  const int len = loop.num_frames;
+  for (int k = 1; k + 1 < len; ++k) {
+    clip_frame_model(take, sk, a + k, mt);
+    clip_frame_model(loop, sk, k, ml);
+    for (int s = 0; s < 2; ++s) {
+      bool inside = false;
+      for (const TimeInterval& iv : an.contacts[s]) {
+        const int f0 = static_cast<int>(std::lround(iv.start_s * take.fps)) - a;
+        const int f1 = static_cast<int>(std::lround(iv.end_s * take.fps)) - a;
+        inside |= f0 > 0 && f1 < len && k >= f0 && k <= f1;
+      }
+      if (!inside) continue;
+      ++checked;
+      const Side sd = static_cast<Side>(s);
+      EXPECT_NEAR(knee_angle_deg(ml, sk, sd), knee_angle_deg(mt, sk, sd), 0.5f)
+          << what << ": frame " << k << " of the cycle, " << (s ? "right" : "left") << " knee";
+    }
+  }
+  return checked;
+}
+
+TEST(Segmentation, ClosingALoopKeepsTheStanceKnees) {
+  int checked = 0;
+  for (const char* file :
+       {"clips/bvh/more/cmu_16_11_walk_veer_left.bvh", "clips/bvh/more/cmu_16_15_walk_mrl30.bvh",
+        "clips/bvh/more/cmu_16_17_walk_90_left_turn_mrl30.bvh",
+        "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
+        "clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh",
+        "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh", "clips/bvh/cmu_07_01_walk.bvh",
+        "clips/bvh/cmu_09_11_run.bvh"}) {
+    REQUIRE_TAKE(file);
+    const Take t = load_take(file);
+    const Skeleton& sk = *t.set.skeleton;
+    ASSERT_FALSE(t.seg.cycles.empty()) << file;
+    // Every stride of the take cut as a cycle, not only the ones chosen: each has its own seam.
+    for (const Stride& st : t.seg.strides) {
+      const int a = static_cast<int>(std::lround(st.span.start_s * t.clip().fps));
+      const Clip loop = extract_cycle(t.clip(), sk, t.analysis, st);
+      checked += expect_stance_knees_kept(
+          t.clip(), sk, t.analysis, loop, a,
+          std::string(file) + " stride at " + std::to_string(st.span.start_s));
+    }
+  }
+  EXPECT_GT(checked, 100);  // the runs' strides have such stances
+}
+
 // The start take (PROVENANCE.md: stands, then speeds up to a 1.3-1.4 m/s walk in about 1.5 s):
 // standing, then a start, then steady walking at the speed of its late windows (1.32, 1.41, 1.36,
 // 1.31 m/s).
