@@ -294,6 +294,60 @@ TEST(Quality, RunnersFeetLandWithoutSnapping) {
   }
 }
 
+// No knee folds backwards: on every frame of every agent, each knee lies on the pelvis's forward
+// side of its hip-ankle line, or at most 2 cm behind it (a knee overextended by about 6 degrees).
+// The subject-16 set with the CMU pair, another skeleton retargeted onto it: the CMU run's cycle
+// held its left knee 11 degrees backwards through the push-off where the loop's seam was closed
+// on the stance leg, and the leg IK folded it back and forth (rush: 461 leg-frames, up to 13 cm
+// behind). Runners, and walkers who speed up into a run and slow down again.
+TEST(Quality, KneesNeverFoldBackwards) {
+  GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh");
+  auto lib = test::load_data_library(
+      {"clips/bvh/more/cmu_16_15_walk_mrl30.bvh", "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh",
+       "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh", "clips/bvh/cmu_07_01_walk.bvh",
+       "clips/bvh/cmu_09_11_run.bvh"});
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const Skeleton& sk = *lib->skeleton;
+  constexpr float kDt = 1.0f / 60.0f;
+  std::vector<test::Script> s;
+  for (int i = 0; i < 4; ++i) {
+    s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, 3.0f + 0.25f * i}));
+    s.push_back({{2.0f * i + 1.0f, 0.0f},
+                 [i](double t) {
+                   return glm::vec2(0.0f, 2.2f + 1.2f * static_cast<float>(std::sin(0.7 * t + i)));
+                 },
+                 nullptr});
+  }
+  test::ScriptedCrowd crowd(std::move(s), false);
+  CrowdPipeline pipeline(*lib, MediatorParams{},
+                         test::test_pipeline_options(crowd.capacity(), kDt, false, false));
+  float worst = 0.0f;
+  int legs = 0;
+  for (int f = 0; f < 900; ++f) {
+    ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
+    const AnimationPlans& pl = pipeline.plans();
+    for (size_t a = 0; a < pl.slot_of_agent.size(); ++a) {
+      const int slot = pl.slot_of_agent[a];
+      if (slot < 0) continue;
+      const std::span<const glm::mat4> w = pipeline.poses().world(slot);
+      const glm::vec3 across =
+          translation_of(w[sk.hip(Side::kLeft)]) - translation_of(w[sk.hip(Side::kRight)]);
+      const glm::vec3 facing = glm::normalize(glm::vec3(-across.z, 0.0f, across.x));
+      for (const Side sd : {Side::kLeft, Side::kRight}) {
+        const glm::vec3 hip = translation_of(w[sk.hip(sd)]), knee = translation_of(w[sk.knee(sd)]),
+                        ankle = translation_of(w[sk.ankle(sd)]);
+        const glm::vec3 axis = glm::normalize(ankle - hip);
+        const glm::vec3 off = (knee - hip) - axis * glm::dot(knee - hip, axis);
+        worst = std::min(worst, glm::dot(off, facing));
+        ++legs;
+      }
+    }
+  }
+  EXPECT_GT(legs, 900 * 8);
+  EXPECT_GT(worst, -0.02f) << "a knee " << -worst * 100.0f << " cm behind its hip-ankle line";
+}
+
 // A library of one jog (the subject-16 take that ends in a sudden stop) played for walkers: below
 // the walk-run speed they walk, whatever the clips, so a pinned ball does not rise with the slowed
 // jog's push-off into a flight it does not have (it stayed up above the low swinging foot, which
