@@ -395,6 +395,39 @@ void add_contact_heights(const LocomotionClip& lc, const Skeleton& sk, ContactHe
   }
 }
 
+// LocomotionLibrary::knee_bend_local from the gait clips (every frame whose knee is bent by at
+// least kBent).
+void lib_knee_bends(const Skeleton& sk, const std::vector<LocomotionClip>& clips,
+                    glm::vec3 (&out)[2]) {
+  const float kBent = std::cos(20.0f * std::numbers::pi_v<float> / 180.0f);
+  glm::vec3 sum[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
+  std::vector<glm::mat4> model(sk.num_joints());
+  for (const LocomotionClip& lc : clips) {
+    if (!lc.gait) continue;
+    for (int f = 0; f < lc.clip.num_frames; ++f) {
+      clip_frame_model(lc.clip, sk, f, model);
+      for (int s = 0; s < 2; ++s) {
+        const Side sd = static_cast<Side>(s);
+        const glm::vec3 hip(model[sk.hip(sd)][3]), knee(model[sk.knee(sd)][3]),
+            ankle(model[sk.ankle(sd)][3]);
+        const glm::vec3 thigh = knee - hip, shin = ankle - knee;
+        const float lt = glm::length(thigh), ls = glm::length(shin);
+        if (!(lt > 1e-4f && ls > 1e-4f) || glm::dot(thigh, shin) > kBent * lt * ls) continue;
+        const glm::vec3 axis = glm::normalize(ankle - hip);
+        const glm::vec3 off = thigh - axis * glm::dot(thigh, axis);
+        const float lo = glm::length(off);
+        if (!(lo > 1e-6f)) continue;
+        const glm::quat hip_q = glm::normalize(glm::quat_cast(glm::mat3(model[sk.hip(sd)])));
+        sum[s] += glm::inverse(hip_q) * (off / lo);
+      }
+    }
+  }
+  for (int s = 0; s < 2; ++s) {
+    const float l = glm::length(sum[s]);
+    out[s] = l > 1e-6f ? sum[s] / l : glm::vec3(0.0f);
+  }
+}
+
 // Where a clip puts a flat foot's toe: a low percentile of its toe heights over its contact frames
 // (both feet); the rest of a contact rolls onto the heel or the ball, higher.
 constexpr float kFlatPercentile = 0.1f;
@@ -1377,6 +1410,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
       lib.planted_toe_m[s] = percentile(h.toe[s], 0.5);
       lib.planted_ankle_m[s] = percentile(h.ankle[s], 0.5);
     }
+    lib_knee_bends(sk, lib.clips, lib.knee_bend_local);
     // The METRICS.md floor is the median height of planted toes, which roll onto heel and ball
     // above a flat foot: the feet are drawn this much higher so a flat foot stands on that floor.
     lib.ground_lift_m =

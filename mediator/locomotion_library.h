@@ -167,6 +167,13 @@ struct LocomotionLibrary {
   // How fast the slowest forward clip moves a toe at the peak of its swing, over the ground at
   // its native speed (median of its swings) [m/s]: the fastest a released foot is carried.
   float swing_speed_m_s = 3.0f;
+  // The way each knee bends, in its hip joint's frame (the thigh's, in which a hinge's plane is
+  // fixed): the mean direction from the hip-ankle line to the knee over the gait clips' frames
+  // where the knee is bent by at least 20 degrees (unit; zero: no such frame). The leg IK bends
+  // the knee toward the drawn knee and, where the drawn leg is nearly straight (its knee's offset
+  // from that line says little, or points backwards a centimetre where a capture overextends
+  // it), toward this: a knee never flips backwards through a straight leg.
+  glm::vec3 knee_bend_local[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
   // Largest per-frame change of any joint's local rotation over all source clips, resampled to
   // 60 Hz [rad] (the pop metric of METRICS.md compares against twice this).
   float max_rotation_step_rad = 0.0f;

@@ -60,6 +60,10 @@ constexpr float kDropHalflife = 0.05f;  // [s]
 // knee's position changes ever faster with the foot's distance, and a hard clamp snaps it.
 constexpr float kIkMaxExtension = 0.999f;
 constexpr float kIkSoften = 0.98f;
+// How far the leg IK's pole leans the way the clips' knees bend, beyond the drawn knee's own
+// offset from the hip-ankle line [fraction of the leg's length]: the offset of a knee bent by
+// about 12 degrees, so a knee bent more keeps the direction it is drawn with.
+constexpr float kKneeBendBias = 0.05f;
 
 // critical_spring, skipped when it is at rest on a goal of 0: it would stay there.
 void settle_spring(float& x, float& v, float goal, const SpringStep& step) {
@@ -1002,9 +1006,16 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
         support_reach_[slot] = SupportReach{};  // let go: it no longer holds the body
       }
     }
+    // The knee bends toward the drawn knee's offset from the hip-ankle line and, by a few
+    // centimetres more, the way the clips' knees bend (LocomotionLibrary::knee_bend_local, in
+    // the thigh's frame): where the drawn leg is nearly straight, or a capture overextends it a
+    // little, the offset alone may point backwards and the knee would fold back.
     const glm::vec3 knee_p = translation_of(world[knee]);
     const glm::vec3 axis = glm::normalize(anim_ankle - hip_p);
-    glm::vec3 pole = (knee_p - hip_p) - axis * glm::dot(knee_p - hip_p, axis);
+    glm::vec3 hinge = glm::mat3(world[hip]) * library_.knee_bend_local[side];
+    if (const float hl = glm::length(hinge); hl > 1e-6f) hinge /= hl;
+    glm::vec3 pole = (knee_p - hip_p) + kKneeBendBias * library_.leg_length_m[side] * hinge;
+    pole -= axis * glm::dot(pole, axis);
     if (glm::length(pole) < 1e-4f) pole = glm::vec3(root[2]);
     // Both legs' IK in one pass (the legs' world joints stay as posed until fk_list below).
     TwoBoneIKLimb& job = ik[side];

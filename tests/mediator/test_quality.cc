@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
@@ -345,6 +346,101 @@ TEST(Quality, KneesNeverFoldBackwards) {
     }
   }
   EXPECT_GT(legs, 900 * 8);
+  EXPECT_GT(worst, -0.02f) << "a knee " << -worst * 100.0f << " cm behind its hip-ankle line";
+}
+
+// The worst knee of a run, as in KneesNeverFoldBackwards: how far behind its hip-ankle line on
+// the pelvis's forward side [m] (negative: behind).
+float worst_knee_behind(const LocomotionLibrary& lib, std::vector<test::Script> scripts,
+                        int frames) {
+  const Skeleton& sk = *lib.skeleton;
+  constexpr float kDt = 1.0f / 60.0f;
+  test::ScriptedCrowd crowd(std::move(scripts), false);
+  CrowdPipeline pipeline(lib, MediatorParams{},
+                         test::test_pipeline_options(crowd.capacity(), kDt, false, false));
+  float worst = 0.0f;
+  for (int f = 0; f < frames; ++f) {
+    EXPECT_TRUE(pipeline.step(crowd, kDt).ok());
+    const AnimationPlans& pl = pipeline.plans();
+    for (size_t a = 0; a < pl.slot_of_agent.size(); ++a) {
+      const int slot = pl.slot_of_agent[a];
+      if (slot < 0) continue;
+      const std::span<const glm::mat4> w = pipeline.poses().world(slot);
+      const glm::vec3 across =
+          translation_of(w[sk.hip(Side::kLeft)]) - translation_of(w[sk.hip(Side::kRight)]);
+      const glm::vec3 facing = glm::normalize(glm::vec3(-across.z, 0.0f, across.x));
+      for (const Side sd : {Side::kLeft, Side::kRight}) {
+        const glm::vec3 hip = translation_of(w[sk.hip(sd)]), knee = translation_of(w[sk.knee(sd)]),
+                        ankle = translation_of(w[sk.ankle(sd)]);
+        const glm::vec3 axis = glm::normalize(ankle - hip);
+        const glm::vec3 off = (knee - hip) - axis * glm::dot(knee - hip, axis);
+        worst = std::min(worst, glm::dot(off, facing));
+      }
+    }
+  }
+  return worst;
+}
+
+// A capture whose knees straighten fully, and a little past it, in the stance (marker noise, a
+// retarget): the leg IK, shortening such a leg, bends the knee forward, the way the clips' knees
+// bend, not backwards the way the drawn knee's few millimetres of overextension point. The CMU
+// walk with each knee that is straighter than 4 degrees turned 4 degrees past straight (the knee
+// then lies about 1.4 cm behind its hip-ankle line), walkers slower and faster than the clip.
+TEST(Quality, OverextendedCaptureKneesStillBendForward) {
+  GK_REQUIRE_DATA("clips/bvh/cmu_07_01_walk.bvh");
+  Result<std::vector<ClipSet>> sets = test::load_data_clip_sets({"clips/bvh/cmu_07_01_walk.bvh"});
+  ASSERT_TRUE(sets.ok()) << sets.message();
+  const Skeleton& sk = *(*sets)[0].skeleton;
+  Clip& c = (*sets)[0].clips.at(0);
+  constexpr float kDeg = std::numbers::pi_v<float> / 180.0f;
+  std::vector<glm::mat4> m(sk.num_joints());
+  int turned = 0;
+  for (int f = 0; f < c.num_frames; ++f) {
+    clip_frame_model(c, sk, f, m);
+    const glm::vec3 left = glm::normalize(translation_of(m[sk.hip(Side::kLeft)]) -
+                                          translation_of(m[sk.hip(Side::kRight)]));
+    for (const Side sd : {Side::kLeft, Side::kRight}) {
+      const glm::vec3 hip = translation_of(m[sk.hip(sd)]), knee = translation_of(m[sk.knee(sd)]),
+                      ankle = translation_of(m[sk.ankle(sd)]);
+      const float bend = std::acos(std::clamp(
+          glm::dot(glm::normalize(knee - hip), glm::normalize(ankle - knee)), -1.0f, 1.0f));
+      if (bend > 4.0f * kDeg) continue;
+      // The shin turned about the body's left-right axis through the knee, the ankle forward:
+      // from `bend` forward to 4 degrees past straight (a knee bent forward has its ankle behind
+      // the thigh's line).
+      const glm::quat thigh = glm::normalize(glm::quat_cast(glm::mat3(m[sk.knee(sd)])) *
+                                             glm::inverse(c.frame_rotations(f)[sk.knee(sd)]));
+      const glm::quat turn = glm::angleAxis(-(bend + 4.0f * kDeg), left);
+      glm::quat& q = c.rotations[static_cast<size_t>(f) * c.num_joints + sk.knee(sd)];
+      q = glm::normalize(glm::inverse(thigh) * turn * thigh * q);
+      ++turned;
+    }
+  }
+  ASSERT_GT(turned, 10);
+  // The clip itself: its knees now lie behind their lines by up to about 1.4 cm.
+  float clip_worst = 0.0f;
+  for (int f = 0; f < c.num_frames; ++f) {
+    clip_frame_model(c, sk, f, m);
+    const glm::vec3 across =
+        translation_of(m[sk.hip(Side::kLeft)]) - translation_of(m[sk.hip(Side::kRight)]);
+    const glm::vec3 facing = glm::normalize(glm::vec3(-across.z, 0.0f, across.x));
+    for (const Side sd : {Side::kLeft, Side::kRight}) {
+      const glm::vec3 hip = translation_of(m[sk.hip(sd)]), knee = translation_of(m[sk.knee(sd)]),
+                      ankle = translation_of(m[sk.ankle(sd)]);
+      const glm::vec3 axis = glm::normalize(ankle - hip);
+      clip_worst =
+          std::min(clip_worst, glm::dot((knee - hip) - axis * glm::dot(knee - hip, axis), facing));
+    }
+  }
+  EXPECT_LT(clip_worst, -0.01f);
+  EXPECT_GT(clip_worst, -0.02f);
+  auto lib = build_locomotion_library(*sets);
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  std::vector<test::Script> s;
+  for (int i = 0; i < 6; ++i) {
+    s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, 0.8f + 0.2f * i}));
+  }
+  const float worst = worst_knee_behind(*lib, std::move(s), 600);
   EXPECT_GT(worst, -0.02f) << "a knee " << -worst * 100.0f << " cm behind its hip-ankle line";
 }
 
