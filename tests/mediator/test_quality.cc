@@ -295,6 +295,49 @@ TEST(Quality, RunnersFeetLandWithoutSnapping) {
   }
 }
 
+// How far a knee lies on the pelvis's forward side of its hip-ankle line in a pose's model or
+// world joints [m] (negative: behind, a knee bent backwards). Forward is across the hips, left
+// to right, turned a quarter about the vertical.
+float knee_ahead_m(std::span<const glm::mat4> w, const Skeleton& sk, Side sd) {
+  const glm::vec3 across =
+      translation_of(w[sk.hip(Side::kLeft)]) - translation_of(w[sk.hip(Side::kRight)]);
+  const glm::vec3 facing = glm::normalize(glm::vec3(-across.z, 0.0f, across.x));
+  const glm::vec3 hip = translation_of(w[sk.hip(sd)]), knee = translation_of(w[sk.knee(sd)]),
+                  ankle = translation_of(w[sk.ankle(sd)]);
+  const glm::vec3 axis = glm::normalize(ankle - hip);
+  return glm::dot((knee - hip) - axis * glm::dot(knee - hip, axis), facing);
+}
+
+// Every knee of every agent on every frame of a scripted run: the worst, how far it lies on the
+// pelvis's forward side of its hip-ankle line [m] (negative: behind), and how many were measured.
+struct KneeCheck {
+  float worst = 0.0f;
+  int legs = 0;
+};
+KneeCheck worst_knee_behind(const LocomotionLibrary& lib, std::vector<test::Script> scripts,
+                            int frames) {
+  const Skeleton& sk = *lib.skeleton;
+  constexpr float kDt = 1.0f / 60.0f;
+  test::ScriptedCrowd crowd(std::move(scripts), false);
+  CrowdPipeline pipeline(lib, MediatorParams{},
+                         test::test_pipeline_options(crowd.capacity(), kDt, false, false));
+  KneeCheck out;
+  for (int f = 0; f < frames; ++f) {
+    EXPECT_TRUE(pipeline.step(crowd, kDt).ok());
+    const AnimationPlans& pl = pipeline.plans();
+    for (size_t a = 0; a < pl.slot_of_agent.size(); ++a) {
+      const int slot = pl.slot_of_agent[a];
+      if (slot < 0) continue;
+      const std::span<const glm::mat4> w = pipeline.poses().world(slot);
+      for (const Side sd : {Side::kLeft, Side::kRight}) {
+        out.worst = std::min(out.worst, knee_ahead_m(w, sk, sd));
+        ++out.legs;
+      }
+    }
+  }
+  return out;
+}
+
 // No knee folds backwards: on every frame of every agent, each knee lies on the pelvis's forward
 // side of its hip-ankle line, or at most 2 cm behind it (a knee overextended by about 6 degrees).
 // The subject-16 set with the CMU pair, another skeleton retargeted onto it: the CMU run's cycle
@@ -309,8 +352,6 @@ TEST(Quality, KneesNeverFoldBackwards) {
        "clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh", "clips/bvh/cmu_07_01_walk.bvh",
        "clips/bvh/cmu_09_11_run.bvh"});
   ASSERT_TRUE(lib.ok()) << lib.message();
-  const Skeleton& sk = *lib->skeleton;
-  constexpr float kDt = 1.0f / 60.0f;
   std::vector<test::Script> s;
   for (int i = 0; i < 4; ++i) {
     s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, 3.0f + 0.25f * i}));
@@ -320,65 +361,10 @@ TEST(Quality, KneesNeverFoldBackwards) {
                  },
                  nullptr});
   }
-  test::ScriptedCrowd crowd(std::move(s), false);
-  CrowdPipeline pipeline(*lib, MediatorParams{},
-                         test::test_pipeline_options(crowd.capacity(), kDt, false, false));
-  float worst = 0.0f;
-  int legs = 0;
-  for (int f = 0; f < 900; ++f) {
-    ASSERT_TRUE(pipeline.step(crowd, kDt).ok());
-    const AnimationPlans& pl = pipeline.plans();
-    for (size_t a = 0; a < pl.slot_of_agent.size(); ++a) {
-      const int slot = pl.slot_of_agent[a];
-      if (slot < 0) continue;
-      const std::span<const glm::mat4> w = pipeline.poses().world(slot);
-      const glm::vec3 across =
-          translation_of(w[sk.hip(Side::kLeft)]) - translation_of(w[sk.hip(Side::kRight)]);
-      const glm::vec3 facing = glm::normalize(glm::vec3(-across.z, 0.0f, across.x));
-      for (const Side sd : {Side::kLeft, Side::kRight}) {
-        const glm::vec3 hip = translation_of(w[sk.hip(sd)]), knee = translation_of(w[sk.knee(sd)]),
-                        ankle = translation_of(w[sk.ankle(sd)]);
-        const glm::vec3 axis = glm::normalize(ankle - hip);
-        const glm::vec3 off = (knee - hip) - axis * glm::dot(knee - hip, axis);
-        worst = std::min(worst, glm::dot(off, facing));
-        ++legs;
-      }
-    }
-  }
-  EXPECT_GT(legs, 900 * 8);
+  const KneeCheck k = worst_knee_behind(*lib, std::move(s), 900);
+  const float worst = k.worst;
+  EXPECT_GT(k.legs, 900 * 8);
   EXPECT_GT(worst, -0.02f) << "a knee " << -worst * 100.0f << " cm behind its hip-ankle line";
-}
-
-// The worst knee of a run, as in KneesNeverFoldBackwards: how far behind its hip-ankle line on
-// the pelvis's forward side [m] (negative: behind).
-float worst_knee_behind(const LocomotionLibrary& lib, std::vector<test::Script> scripts,
-                        int frames) {
-  const Skeleton& sk = *lib.skeleton;
-  constexpr float kDt = 1.0f / 60.0f;
-  test::ScriptedCrowd crowd(std::move(scripts), false);
-  CrowdPipeline pipeline(lib, MediatorParams{},
-                         test::test_pipeline_options(crowd.capacity(), kDt, false, false));
-  float worst = 0.0f;
-  for (int f = 0; f < frames; ++f) {
-    EXPECT_TRUE(pipeline.step(crowd, kDt).ok());
-    const AnimationPlans& pl = pipeline.plans();
-    for (size_t a = 0; a < pl.slot_of_agent.size(); ++a) {
-      const int slot = pl.slot_of_agent[a];
-      if (slot < 0) continue;
-      const std::span<const glm::mat4> w = pipeline.poses().world(slot);
-      const glm::vec3 across =
-          translation_of(w[sk.hip(Side::kLeft)]) - translation_of(w[sk.hip(Side::kRight)]);
-      const glm::vec3 facing = glm::normalize(glm::vec3(-across.z, 0.0f, across.x));
-      for (const Side sd : {Side::kLeft, Side::kRight}) {
-        const glm::vec3 hip = translation_of(w[sk.hip(sd)]), knee = translation_of(w[sk.knee(sd)]),
-                        ankle = translation_of(w[sk.ankle(sd)]);
-        const glm::vec3 axis = glm::normalize(ankle - hip);
-        const glm::vec3 off = (knee - hip) - axis * glm::dot(knee - hip, axis);
-        worst = std::min(worst, glm::dot(off, facing));
-      }
-    }
-  }
-  return worst;
 }
 
 // A capture whose knees straighten fully, and a little past it, in the stance (marker noise, a
@@ -421,15 +407,8 @@ TEST(Quality, OverextendedCaptureKneesStillBendForward) {
   float clip_worst = 0.0f;
   for (int f = 0; f < c.num_frames; ++f) {
     clip_frame_model(c, sk, f, m);
-    const glm::vec3 across =
-        translation_of(m[sk.hip(Side::kLeft)]) - translation_of(m[sk.hip(Side::kRight)]);
-    const glm::vec3 facing = glm::normalize(glm::vec3(-across.z, 0.0f, across.x));
     for (const Side sd : {Side::kLeft, Side::kRight}) {
-      const glm::vec3 hip = translation_of(m[sk.hip(sd)]), knee = translation_of(m[sk.knee(sd)]),
-                      ankle = translation_of(m[sk.ankle(sd)]);
-      const glm::vec3 axis = glm::normalize(ankle - hip);
-      clip_worst =
-          std::min(clip_worst, glm::dot((knee - hip) - axis * glm::dot(knee - hip, axis), facing));
+      clip_worst = std::min(clip_worst, knee_ahead_m(m, sk, sd));
     }
   }
   EXPECT_LT(clip_worst, -0.01f);
@@ -440,7 +419,7 @@ TEST(Quality, OverextendedCaptureKneesStillBendForward) {
   for (int i = 0; i < 6; ++i) {
     s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, 0.8f + 0.2f * i}));
   }
-  const float worst = worst_knee_behind(*lib, std::move(s), 600);
+  const float worst = worst_knee_behind(*lib, std::move(s), 600).worst;
   EXPECT_GT(worst, -0.02f) << "a knee " << -worst * 100.0f << " cm behind its hip-ankle line";
 }
 
