@@ -167,11 +167,10 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
         // and the foot's rest against the clip's speed is carried on and shed (inertialization),
         // so the drawn foot sets off from rest: taking the clip's lift-off speed at once, the
         // knee of a leg stretched to its pin would snap. A pin that rises with the clip's toe
-        // (pin_height: a run's ball rising into the push-off) is taken as it was last frame too:
-        // raised to this frame's height first, it then rose by the clip's rise once more, twice
-        // the clip's in the release's frame (a ball snatched up 4 cm in a frame at a run's
-        // push-off).
-        // It sets off at the speed it was rising.
+        // (pin_height: a run's ball rising into the push-off) is taken as it was last frame too,
+        // and sets off at the speed it was rising: raised to this frame's height first, it then
+        // rose by the clip's rise once more, twice the clip's in the release's frame (a ball
+        // snatched up 4 cm in a frame at a run's push-off).
         const glm::vec3 was = s.target + s.offset;
         pin_height(s, in);
         glm::vec3 drawn = s.target + s.offset;
