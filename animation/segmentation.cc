@@ -482,8 +482,8 @@ Clip extract_cycle(const Clip& take, const Skeleton& sk, const ClipAnalysis& an,
                                    std::max(1, swing_to[s] - swing_from[s]));
         }
         if (w == 0.0f) continue;
-        const glm::quat turn = w > 0.0f ? glm::slerp(glm::quat(1, 0, 0, 0), diff, w)
-                                        : glm::slerp(glm::quat(1, 0, 0, 0), glm::inverse(diff), -w);
+        const glm::quat turn =
+            glm::slerp(glm::quat(1, 0, 0, 0), w > 0.0f ? diff : glm::inverse(diff), std::abs(w));
         R(k, j) = glm::normalize(turn * R(k, j));
         if (j == 0) {
           T(k, j).y += w * dt.y;  // the root's travel stays its own; its height closes

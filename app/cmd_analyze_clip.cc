@@ -317,7 +317,8 @@ void add_analyze_clip_command(CLI::App& app) {
   auto opt = std::make_shared<AnalyzeOptions>();
   CLI::App* cmd = app.add_subcommand(
       "analyze-clip",
-      "Analyse clips: unit scale, IK-style feet re-parented under the shins, native speed and "
+      "Analyse clips: unit scale, up axis (a Z-up or X-up BVH stood up along +y), IK-style feet "
+      "re-parented under the shins, native speed and "
       "direction, gait cycle, foot contacts, foot-slide floor; a take's segments (idle, start, "
       "steady, turn, stop) and the loops cut from it (without a steady stride: its steadiest "
       "step and that step's mirror image).");

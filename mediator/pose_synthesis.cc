@@ -1012,8 +1012,8 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // little, the offset alone may point backwards and the knee would fold back.
     const glm::vec3 knee_p = translation_of(world[knee]);
     const glm::vec3 axis = glm::normalize(anim_ankle - hip_p);
-    glm::vec3 hinge = glm::mat3(world[hip]) * library_.knee_bend_local[side];
-    if (const float hl = glm::length(hinge); hl > 1e-6f) hinge /= hl;
+    // (World joints are rigid: the turned unit vector stays a unit one, or zero.)
+    const glm::vec3 hinge = glm::mat3(world[hip]) * library_.knee_bend_local[side];
     glm::vec3 pole = (knee_p - hip_p) + kKneeBendBias * library_.leg_length_m[side] * hinge;
     pole -= axis * glm::dot(pole, axis);
     if (glm::length(pole) < 1e-4f) pole = glm::vec3(root[2]);
