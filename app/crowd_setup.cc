@@ -94,8 +94,8 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
   CLI::Option* scenario = cmd->add_option(
       "--scenario", o->scenario,
       "Scenario name (data/scenarios, or $GAITKEEPER_SCENARIOS), a scenario .json file, "
-      "or an ETH/UCY trajectory .txt file to replay (frame id x y, or the ETH authors' 8-column "
-      "obsmat.txt)");
+      "or a trajectory file to replay (.txt, .csv, .tsv or .dat: ETH/UCY's frame id x y, the ETH "
+      "authors' 8-column obsmat.txt, or CSV with a header naming frame, id, x and y)");
   if (scenario_required) scenario->required();
   cmd->add_option("--sim", o->sim, "Crowd simulator: social (default) or detour");
   cmd->add_option("--agents", o->agents,
@@ -163,7 +163,7 @@ CrowdSetup make_crowd(const CrowdOptions& o, int threads, uint64_t seed, float b
              ": UCY spline annotations (.vsp, pixels) are not read; replay the file in metres "
              "(frame id x y per line, e.g. ../shared/data/trajectories/zara1/crowds_zara01.txt)");
   }
-  if (ends_with(o.scenario, ".txt")) {
+  if (is_trajectory_file_name(o.scenario)) {
     if (o.sim != "social") {
       fail(cmd, 2, "--sim " + o.sim + " needs a scenario, not a trajectory file");
     }

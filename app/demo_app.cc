@@ -16,6 +16,7 @@
 
 #include "app/commands.h"
 #include "app/offscreen.h"
+#include "crowd/trajectory_replay.h"
 
 namespace gk::app {
 namespace {
@@ -48,7 +49,7 @@ DemoApp::DemoApp(DemoOptions options) : options_(std::move(options)) {
     overlays_.torso = true;  // only the selected agent has a fan: nothing shows until a click
   }
   compare_ = options_.compare;
-  if (ends_with(crowd_.scenario, ".txt")) sim_kind_ = 2, replay_path_ = crowd_.scenario;
+  if (is_trajectory_file_name(crowd_.scenario)) sim_kind_ = 2, replay_path_ = crowd_.scenario;
   if (crowd_.sim == "detour") sim_kind_ = 1;
   builtin_clips_ = crowd_.clips.empty();
   if (!builtin_clips_) clip_path_ = crowd_.clips.front();

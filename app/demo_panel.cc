@@ -14,6 +14,7 @@
 
 #include "app/demo_app.h"
 #include "app/param_labels.h"
+#include "crowd/trajectory_replay.h"
 
 namespace gk::app {
 namespace {
@@ -122,10 +123,12 @@ void DemoApp::panel_crowd() {
     row("trajectory file");
     ImGui::InputText("##trajectory", &replay_path_);
     help_marker(
-        "An ETH/UCY trajectory .txt file (frame id x y, or ETH's 8-column obsmat.txt), e.g. "
+        "A trajectory file: ETH/UCY .txt (frame id x y, or ETH's 8-column obsmat.txt), or CSV "
+        "(.csv, .tsv, .dat) with a header naming frame, id, x and y; e.g. "
         "../shared/data/trajectories/zara1/crowds_zara01.txt");
     if (ImGui::Button("browse...##trajectory")) {
-      browser_.open("Trajectory file", browse_start(replay_path_, "trajectories"), {".txt"},
+      browser_.open("Trajectory file", browse_start(replay_path_, "trajectories"),
+                    {".txt", ".csv", ".tsv", ".dat"},
                     FileBrowser::Mode::kOpen, false, kBrowseTrajectory);
     }
     ImGui::SameLine();
@@ -208,7 +211,7 @@ void DemoApp::apply_crowd() {
     crowd_.scenario = replay_path_;
     crowd_.agents.clear();
   } else {
-    if (ends_with(crowd_.scenario, ".txt")) crowd_.scenario = "crossing";
+    if (is_trajectory_file_name(crowd_.scenario)) crowd_.scenario = "crossing";
     crowd_.agents = agents_edited_ ? std::to_string(std::max(agents_, 0)) : "";
   }
   crowd_.clips.clear();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -28,10 +29,49 @@ struct Row {
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
-// Splits a line on spaces/tabs into at most `max_tokens` tokens; returns the total token count
-// (which may exceed max_tokens, to report it).
-int split_tokens(std::string_view line, std::string_view* out_tokens, int max_tokens) {
+std::string_view trim(std::string_view t) {
+  while (!t.empty() && is_space(t.front())) t.remove_prefix(1);
+  while (!t.empty() && is_space(t.back())) t.remove_suffix(1);
+  return t;
+}
+
+// How a file's fields are separated: runs of spaces and tabs (the ETH/UCY releases), or one comma
+// or semicolon each (CSV: two separators in a row leave an empty field, reported as such).
+enum class Separator : uint8_t { kBlank, kComma, kSemicolon };
+
+// Judged on the file's first row: a comma or semicolon in a row of text makes the file CSV (a
+// row that is not text, such as a binary file's bytes, is split on blanks and fails as data).
+Separator separator_of(std::string_view first_row) {
+  if (!std::all_of(first_row.begin(), first_row.end(),
+                   [](char ch) { return (ch >= 0x20 && ch < 0x7F) || is_space(ch); })) {
+    return Separator::kBlank;
+  }
+  if (first_row.find(',') != std::string_view::npos) return Separator::kComma;
+  if (first_row.find(';') != std::string_view::npos) return Separator::kSemicolon;
+  return Separator::kBlank;
+}
+
+// Splits a line into at most `max_tokens` tokens; returns the total token count (which may
+// exceed max_tokens, to report it).
+int split_tokens(std::string_view line, Separator sep, std::string_view* out_tokens,
+                 int max_tokens) {
   int count = 0;
+  if (sep != Separator::kBlank) {
+    const char c = sep == Separator::kComma ? ',' : ';';
+    line = trim(line);
+    size_t start = 0;
+    while (true) {
+      const size_t end = line.find(c, start);
+      const std::string_view field =
+          trim(line.substr(start, end == std::string_view::npos ? std::string_view::npos
+                                                                : end - start));
+      if (count < max_tokens) out_tokens[count] = field;
+      ++count;
+      if (end == std::string_view::npos) break;
+      start = end + 1;
+    }
+    return count;
+  }
   size_t i = 0;
   while (i < line.size()) {
     while (i < line.size() && is_space(line[i])) ++i;
@@ -44,78 +84,183 @@ int split_tokens(std::string_view line, std::string_view* out_tokens, int max_to
   return count;
 }
 
-Status parse_number(std::string_view token, const char* column, const std::string& file, int line,
-                    double* out_value) {
+Status parse_number(std::string_view token, const std::string& column, const std::string& file,
+                    int line, double* out_value) {
   double value = 0.0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (ec != std::errc() || end != token.data() + token.size()) {
-    return Status::AtLine(
-        file, line, std::string(column) + ": expected a number, found " + quoted_snippet(token));
+  if (ec != std::errc() || end != token.data() + token.size() || token.empty()) {
+    return Status::AtLine(file, line, column + ": expected a number, found " + quoted_snippet(token));
   }
   if (!std::isfinite(value)) {
-    return Status::AtLine(
-        file, line,
-        std::string(column) + ": expected a finite number, found " + quoted_snippet(token));
+    return Status::AtLine(file, line,
+                          column + ": expected a finite number, found " + quoted_snippet(token));
   }
   *out_value = value;
   return Status::Ok();
 }
 
-// The two layouts a trajectory file may have, by their column count (all of a file's rows alike):
-// 4, the common one of the Social-LSTM/GAN releases; 8, the ETH (BIWI) authors' obsmat.txt, whose
-// ground plane is (pos_x, pos_y) and whose pos_z and velocity columns are not used (the replay
-// derives velocity from the positions).
+// The two layouts a trajectory file without a header may have, by their column count (all of a
+// file's rows alike): 4, the common one of the Social-LSTM/GAN releases; 8, the ETH (BIWI)
+// authors' obsmat.txt, whose ground plane is (pos_x, pos_y) and whose pos_z and velocity columns
+// are not used (the replay derives velocity from the positions). A file with a header row names
+// its columns instead, in any order and with any others beside them.
 constexpr const char* kLayouts =
     "expected 4 numbers (frame id x y) or 8 (ETH obsmat: frame id pos_x pos_z pos_y v_x v_z v_y)";
+constexpr const char* kHeaderNames =
+    "a header names the columns frame (or frame_id), id (or ped, ped_id, agent_id, track_id, "
+    "person_id), x (or pos_x) and y (or pos_y)";
+constexpr int kMaxColumns = 64;
 
-// `columns`: the file's layout, 0 until its first row sets it.
-Status parse_row(std::string_view text, const std::string& file, int line, int* columns,
-                 Row* out_row) {
-  constexpr int kMaxTokens = 8;
-  std::string_view tokens[kMaxTokens];
-  const int count = split_tokens(text, tokens, kMaxTokens);
-  if (count != 4 && count != 8) {
-    return Status::AtLine(file, line, std::string(kLayouts) + ", found " + std::to_string(count));
+// The file's layout: its separator, its column count and where frame, id, x and y are.
+struct Layout {
+  Separator sep = Separator::kBlank;
+  int columns = 0;  // 0 until the first row sets it
+  bool header = false;
+  int at[4] = {0, 1, 2, 3};  // frame, id, x, y
+  std::string names[4] = {"column 1 (frame)", "column 2 (id)", "column 3 (x)", "column 4 (y)"};
+};
+
+// A header's name, lower case, without quotes, blanks, '_', '-' or '.'.
+std::string normalised_name(std::string_view t) {
+  std::string n;
+  for (char c : t) {
+    if (c == '"' || c == '\'' || c == '_' || c == '-' || c == '.' || is_space(c)) continue;
+    n.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
   }
-  if (*columns == 0) *columns = count;
-  if (count != *columns) {
+  return n;
+}
+
+// Which of frame (0), id (1), x (2), y (3) a header name stands for; -1 for none.
+int header_role(const std::string& n) {
+  static const std::pair<const char*, int> kNames[] = {
+      {"frame", 0},       {"frameid", 0},  {"framenumber", 0}, {"framenum", 0},
+      {"frameindex", 0},  {"id", 1},       {"ped", 1},         {"pedid", 1},
+      {"pedestrian", 1},  {"pedestrianid", 1}, {"agent", 1},   {"agentid", 1},
+      {"track", 1},       {"trackid", 1},  {"person", 1},      {"personid", 1},
+      {"objectid", 1},    {"objid", 1},    {"x", 2},           {"posx", 2},
+      {"positionx", 2},   {"xm", 2},       {"y", 3},           {"posy", 3},
+      {"positiony", 3},   {"ym", 3}};
+  for (const auto& [name, role] : kNames) {
+    if (n == name) return role;
+  }
+  return -1;
+}
+
+// A first row whose first field is not a number is a header: it sets the layout by its names.
+Status parse_header(const std::string_view* tokens, int count, const std::string& file, int line,
+                    Layout* layout) {
+  if (count > kMaxColumns) {
     return Status::AtLine(file, line,
-                          "expected " + std::to_string(*columns) +
-                              " numbers as on the file's first row, found " +
+                          "header: at most " + std::to_string(kMaxColumns) + " columns, found " +
                               std::to_string(count));
   }
-  static constexpr const char* kColumns[4] = {"column 1 (frame)", "column 2 (id)",
-                                              "column 3 (x)", "column 4 (y)"};
-  static constexpr const char* kObsmatColumns[8] = {
-      "column 1 (frame)", "column 2 (id)",  "column 3 (pos_x)", "column 4 (pos_z)",
-      "column 5 (pos_y)", "column 6 (v_x)", "column 7 (v_z)",   "column 8 (v_y)"};
-  const char* const* names = count == 8 ? kObsmatColumns : kColumns;
-  double values[kMaxTokens];
+  int found[4] = {-1, -1, -1, -1};
   for (int c = 0; c < count; ++c) {
-    GK_RETURN_IF_ERROR(parse_number(tokens[c], names[c], file, line, &values[c]));
+    const int role = header_role(normalised_name(tokens[c]));
+    if (role < 0) continue;
+    if (found[role] >= 0) {
+      return Status::AtLine(file, line,
+                            "header: columns " + std::to_string(found[role] + 1) + " (" +
+                                quoted_snippet(tokens[found[role]]) + ") and " +
+                                std::to_string(c + 1) + " (" + quoted_snippet(tokens[c]) +
+                                ") name the same quantity");
+    }
+    found[role] = c;
   }
-  // Ground-plane columns: x and y, or obsmat's pos_x and pos_y.
-  const int gx = 2, gy = count == 8 ? 4 : 3;
+  static constexpr const char* kWhat[4] = {"frame", "id", "x", "y"};
+  for (int r = 0; r < 4; ++r) {
+    if (found[r] < 0) {
+      std::string names;
+      for (int c = 0; c < count && c < 8; ++c) {
+        names += (c ? ", " : "") + quoted_snippet(tokens[c]);
+      }
+      return Status::AtLine(file, line,
+                            std::string("header: no column for ") + kWhat[r] + " among " + names +
+                                "; " + kHeaderNames);
+    }
+    layout->at[r] = found[r];
+    layout->names[r] = "column " + std::to_string(found[r] + 1) + " (" +
+                       std::string(trim(tokens[found[r]])) + ")";
+  }
+  layout->columns = count;
+  layout->header = true;
+  return Status::Ok();
+}
+
+// Parses one data row into `out_row`; the first row of the file (`layout->columns` == 0) may be a
+// header instead, which sets the layout and leaves `*is_header` true.
+Status parse_row(std::string_view text_row, const std::string& file, int line, Layout* layout,
+                 Row* out_row, bool* is_header) {
+  *is_header = false;
+  const bool first = layout->columns == 0;
+  if (first) layout->sep = separator_of(text_row);
+  std::string_view tokens[kMaxColumns];
+  const int count = split_tokens(text_row, layout->sep, tokens, kMaxColumns);
+  if (first) {
+    double v = 0.0;
+    const std::string_view t0 = count > 0 ? tokens[0] : std::string_view();
+    const auto [end, ec] = std::from_chars(t0.data(), t0.data() + t0.size(), v);
+    // A header is text: printable ASCII with a letter in its first name (anything else, such
+    // as a binary file's bytes, is a data row that fails as one).
+    const bool text = std::all_of(text_row.begin(), text_row.end(),
+                                  [](char ch) { return ch >= 0x20 && ch < 0x7F; }) &&
+                      std::any_of(t0.begin(), t0.end(), [](char ch) {
+                        return std::isalpha(static_cast<unsigned char>(ch)) != 0;
+                      });
+    if (text && (ec != std::errc() || end != t0.data() + t0.size())) {
+      *is_header = true;
+      return parse_header(tokens, count, file, line, layout);
+    }
+    if (count != 4 && count != 8) {
+      return Status::AtLine(file, line,
+                            std::string(kLayouts) + ", or " + kHeaderNames + "; found " +
+                                std::to_string(count) + " fields");
+    }
+    layout->columns = count;
+    if (count == 8) {
+      // obsmat: frame id pos_x pos_z pos_y v_x v_z v_y; the ground plane is (pos_x, pos_y).
+      layout->at[3] = 4;
+      layout->names[2] = "column 3 (pos_x)";
+      layout->names[3] = "column 5 (pos_y)";
+    }
+  } else if (count != layout->columns) {
+    if (!layout->header && (count == 4 || count == 8)) {
+      return Status::AtLine(file, line,
+                            "expected " + std::to_string(layout->columns) +
+                                " numbers as on the file's first row, found " +
+                                std::to_string(count));
+    }
+    return Status::AtLine(file, line,
+                          layout->header
+                              ? "expected " + std::to_string(layout->columns) +
+                                    " fields as the header names, found " + std::to_string(count)
+                              : std::string(kLayouts) + ", found " + std::to_string(count));
+  }
+  double values[4];
+  for (int r = 0; r < 4; ++r) {
+    GK_RETURN_IF_ERROR(parse_number(tokens[layout->at[r]], layout->names[r], file, line, &values[r]));
+  }
+  const std::string_view frame_token = tokens[layout->at[0]], id_token = tokens[layout->at[1]];
   if (values[0] < 0.0 || values[0] > kMaxFrame || values[0] != std::floor(values[0])) {
     return Status::AtLine(file, line,
-                          "column 1 (frame): expected a whole number in [0, 2^31), found " +
-                              quoted_snippet(tokens[0]));
+                          layout->names[0] + ": expected a whole number in [0, 2^31), found " +
+                              quoted_snippet(frame_token));
   }
   if (values[1] < 0.0 || values[1] > kMaxId || values[1] != std::floor(values[1])) {
-    return Status::AtLine(
-        file, line,
-        "column 2 (id): expected a whole number in [0, 2^32), found " + quoted_snippet(tokens[1]));
+    return Status::AtLine(file, line,
+                          layout->names[1] + ": expected a whole number in [0, 2^32), found " +
+                              quoted_snippet(id_token));
   }
-  for (const int c : {gx, gy}) {
-    if (std::abs(values[c]) > kMaxCoordinate_m) {
+  for (const int r : {2, 3}) {
+    if (std::abs(values[r]) > kMaxCoordinate_m) {
       return Status::AtLine(file, line,
-                            std::string(names[c]) + ": expected a coordinate within +-1e5 m, " +
-                                "found " + quoted_snippet(tokens[c]));
+                            layout->names[r] + ": expected a coordinate within +-1e5 m, " +
+                                "found " + quoted_snippet(tokens[layout->at[r]]));
     }
   }
   out_row->frame = static_cast<int64_t>(values[0]);
   out_row->id = static_cast<uint32_t>(values[1]);
-  out_row->position = glm::vec2(static_cast<float>(values[gx]), static_cast<float>(values[gy]));
+  out_row->position = glm::vec2(static_cast<float>(values[2]), static_cast<float>(values[3]));
   out_row->line = line;
   return Status::Ok();
 }
@@ -154,21 +299,24 @@ Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::
   rows.reserve(text.size() / 8 + 1);
   int line = 0;
   size_t pos = 0;
-  int columns = 0;  // the file's layout (4 or 8), set by its first row
+  Layout layout;  // set by the file's first row (a header, or 4 or 8 numbers)
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
     const std::string_view line_text = text.substr(pos, end - pos);
     pos = end + 1;
     ++line;
-    if (std::all_of(line_text.begin(), line_text.end(), is_space)) continue;  // blank line
+    const std::string_view content = trim(line_text);
+    if (content.empty() || content.front() == '#') continue;  // blank line or comment
     Row row{};
-    GK_RETURN_IF_ERROR(parse_row(line_text, file_name, line, &columns, &row));
-    rows.push_back(row);
+    bool header = false;
+    GK_RETURN_IF_ERROR(parse_row(content, file_name, line, &layout, &row, &header));
+    if (!header) rows.push_back(row);
   }
   if (rows.empty()) {
     return Status::AtLine(file_name, std::max(line, 1),
-                          std::string("no trajectory rows: ") + kLayouts + " per line");
+                          std::string("no trajectory rows: ") + kLayouts + " per line, or " +
+                              kHeaderNames);
   }
 
   std::sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {

@@ -1,6 +1,8 @@
 #include "crowd/trajectory_replay.h"
 
+
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numeric>
 #include <vector>
@@ -294,6 +296,16 @@ void TrajectoryReplay::update_live(float dt_s) {
 }
 
 }  // namespace
+
+bool is_trajectory_file_name(std::string_view path) {
+  const size_t dot = path.rfind('.');
+  if (dot == std::string_view::npos || path.find('/', dot) != std::string_view::npos) return false;
+  std::string ext;
+  for (char ch : path.substr(dot + 1)) {
+    ext.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(ch))));
+  }
+  return ext == "txt" || ext == "csv" || ext == "tsv" || ext == "dat";
+}
 
 Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(
     const std::string& path, const ReplayOptions& options,

@@ -1,7 +1,9 @@
 #pragma once
 // Replay of recorded pedestrian trajectories in the ETH/UCY text format (frame, id, x, y per line,
 // tab or space separated; or the ETH authors' obsmat.txt, frame id pos_x pos_z pos_y v_x v_z v_y,
-// whose ground plane is (pos_x, pos_y)). Positions are resampled smoothly (C1: no velocity jumps) to the
+// whose ground plane is (pos_x, pos_y)), or as CSV (comma or semicolon separated), with or without
+// a header row that names the frame, id, x and y columns (in any order, among others); lines
+// beginning with '#' are comments. Positions are resampled smoothly (C1: no velocity jumps) to the
 // simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
 // is ignored: the data is the truth.
 //
@@ -16,13 +18,14 @@
 // (exact at the recorded times, no overshoot per axis), velocity is its derivative and theta is the
 // smoothed heading of the velocity, held while the speed is below 0.1 m/s.
 //
-// Errors (file and line): wrong column count, non-numbers, NaN/inf, frame not a whole number in
+// Errors (file and line): a header without frame, id, x or y, wrong column count, non-numbers, NaN/inf, frame not a whole number in
 // [0, 2^31), id not a whole number in [0, 2^32), duplicate (frame, id), no rows at all.
 //
 // With ReplayOptions::loop the file plays round and round for as long as it is stepped.
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "crowd/crowd_source.h"
@@ -39,6 +42,9 @@ struct ReplayOptions {
   // so each comes back as a new agent with its id (absent for at least that step).
   bool loop = false;
 };
+
+// True for the file names a trajectory file may have: .txt, .csv, .tsv or .dat (any case).
+bool is_trajectory_file_name(std::string_view path);
 
 // `out_pedestrian_ids` (optional) receives every pedestrian id of the file, sorted, so that an
 // option naming an agent can be checked before the replay runs.

@@ -59,7 +59,7 @@ seed fuzz_bvh "$data"/clips/bvh/*.bvh "$data"/clips/bvh/more/*.bvh tests/data/go
 seed fuzz_gltf "$data"/clips/gltf/*.glb tests/data/good/*.gltf tests/data/bad/*.gltf
 seed fuzz_scenario data/scenarios/*.json tests/data/bad/scenarios/*.json
 seed fuzz_trajectory "$data"/trajectories/*/*.txt "$data"/trajectories/*/original/obsmat.txt \
-  tests/data/bad/trajectories/*.txt
+  tests/data/bad/trajectories/*.txt tests/data/good/trajectories/*
 # The .gltf fixtures again as small .glb files (a JSON chunk only; their buffers are data: URIs),
 # so that the binary path has seeds other than the 3 MB mannequin.
 le32() { printf '\\x%02x\\x%02x\\x%02x\\x%02x' $(($1 & 255)) $(($1 >> 8 & 255)) \

@@ -324,7 +324,6 @@ TEST(TrajectoryReplay, MalformedFilesNameFileAndLine) {
       {"empty.txt", 1, "no trajectory rows"},
       {"duplicate_row.txt", 4, "duplicate row for frame 10, pedestrian 1 (first at line 2)"},
       {"huge_id.txt", 2, "column 2 (id): expected a whole number"},
-      {"comment_line.txt", 1, "expected 4 numbers"},
       {"negative_frame.txt", 2, "column 1 (frame): expected a whole number"},
   };
   for (const auto& c : kCases) {
@@ -347,6 +346,91 @@ TEST(TrajectoryReplay, MalformedFilesNameFileAndLine) {
   r = load_trajectory_replay(test::scratch_dir("replay") + "/does_not_exist.txt");
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.message().find("does_not_exist.txt: cannot open"), std::string::npos);
+}
+
+// A CSV export of a recorded crowd replays exactly as the ETH/UCY file it came from: the rows of
+// crowds_zara01.txt rewritten here with commas (then semicolons and CRLF), a header that names
+// the columns in another order, an extra column and a comment line.
+TEST(TrajectoryReplay, CsvWithAHeaderReplaysAsTheEthUcyFile) {
+  const char* rel = "trajectories/zara1/crowds_zara01.txt";
+  GK_REQUIRE_DATA(rel);
+  std::ifstream in(test::data_path(rel));
+  std::string f, id, x, y;
+  std::string comma = "# zara01 as CSV\nagent_id,Pos_Y,speed,pos_x,frame_id\n";
+  std::string semi = "\"ped\";\"frame\";\"x\";\"y\"\r\n";
+  size_t rows = 0;
+  while (in >> f >> id >> x >> y) {
+    comma += id + "," + y + ",1.0," + x + "," + f + "\n";
+    semi += id + " ; " + f + ";" + x + ";" + y + "\r\n";
+    ++rows;
+  }
+  ASSERT_GT(rows, 5000u);
+  auto txt = load(test::data_path(rel), 0.4f);
+  auto csv = load(write_scratch("zara01.csv", comma), 0.4f);
+  auto dat = load(write_scratch("zara01.dat", semi), 0.4f);
+  ASSERT_TRUE(txt && csv && dat);
+  size_t compared = 0;
+  for (int frame = 0; frame < 60 * 90; ++frame) {
+    for (CrowdSource* s : {txt.get(), csv.get(), dat.get()}) ASSERT_TRUE(s->step(1.0f / 60.0f).ok());
+    const AgentFrame a = txt->frame();
+    for (const AgentFrame& b : {csv->frame(), dat->frame()}) {
+      ASSERT_EQ(a.size(), b.size());
+      for (size_t i = 0; i < a.size(); ++i) {
+        ASSERT_EQ(a.ids[i], b.ids[i]);
+        ASSERT_EQ(a.positions[i], b.positions[i]);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 50000u);
+  // The comment line of the old fixture is skipped rather than refused.
+  auto commented = load(test::source_path("tests/data/good/trajectories/comment_line.txt"), 0.4f);
+  ASSERT_TRUE(commented);
+  EXPECT_EQ(commented->capacity(), 1u);
+  // Columns found by name: x = 1.0, 1.5, 2.0 at frames 0, 10, 20 of pedestrian 1, y = 2.
+  auto named = load(test::source_path("tests/data/good/trajectories/header_semicolon.csv"), 0.4f);
+  ASSERT_TRUE(named);
+  ASSERT_TRUE(named->step(0.4f).ok());
+  ASSERT_EQ(named->frame().size(), 1u);
+  EXPECT_EQ(named->frame().ids[0], 1u);
+  EXPECT_NEAR(named->frame().positions[0].x, 1.5f, 1e-5f);
+  EXPECT_NEAR(named->frame().positions[0].y, 2.0f, 1e-5f);
+}
+
+// A header or CSV row that cannot be read names the line and what was expected.
+TEST(TrajectoryReplay, MalformedCsvNamesLineAndColumn) {
+  const struct {
+    const char* text;
+    int line;
+    const char* what;
+  } kCases[] = {
+      {"frame,id,x\n0,1,2\n", 1, "header: no column for y among 'frame', 'id', 'x'"},
+      {"frame,id,x,pos_x,y\n", 1, "header: columns 3 ('x') and 4 ('pos_x') name the same"},
+      {"\n# c\nframe;id;x;y\n0;1;2;3\n10;1;2\n", 5, "expected 4 fields as the header names, found 3"},
+      {"frame,id,x,y\n0,1,,3\n", 2, "column 3 (x): expected a number, found ''"},
+      {"id,frame,x,y\n1,2.5,0,0\n", 2, "column 2 (frame): expected a whole number"},
+      {"0,1,2,3\n10,1,2,3,4,5\n", 2, "expected 4 numbers (frame id x y) or 8"},
+      {"0,1,2\n", 1, "or a header names the columns frame"},
+      {"frame,id,x,y\n", 1, "no trajectory rows"},
+  };
+  int k = 0;
+  for (const auto& c : kCases) {
+    const std::string path = write_scratch("bad" + std::to_string(k++) + ".csv", c.text);
+    Result<std::unique_ptr<CrowdSource>> r = load_trajectory_replay(path);
+    ASSERT_FALSE(r.ok()) << c.text;
+    const std::string prefix = path + ":" + std::to_string(c.line) + ": ";
+    EXPECT_EQ(r.message().rfind(prefix, 0), 0u) << r.message();
+    EXPECT_NE(r.message().find(c.what), std::string::npos) << r.message();
+  }
+}
+
+TEST(TrajectoryReplay, TrajectoryFileNames) {
+  for (const char* yes : {"a.txt", "dir.x/b.CSV", "c.tsv", "../d/e.dat", "obsmat.txt"}) {
+    EXPECT_TRUE(is_trajectory_file_name(yes)) << yes;
+  }
+  for (const char* no : {"plaza", "scene.json", "a.vsp", "dir.csv/plaza", "csv", "a.txt.json"}) {
+    EXPECT_FALSE(is_trajectory_file_name(no)) << no;
+  }
 }
 
 // True when every byte is printable ASCII or a newline: no raw file bytes reached the message.
