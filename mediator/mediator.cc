@@ -84,6 +84,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
     v->assign(capacity, 0.0f);
   }
   tr_rate_.assign(capacity, 1.0f);
+  tr_start_due_.assign(capacity, 0);
   tr_counts_.assign(capacity * kNumCounts, 0);
   lod_plan_.assign(capacity, 1);
   lod_dt_s_.assign(capacity, 0.0f);
@@ -283,7 +284,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                   pl.layer_weight, pl.gait_weight, pl.phase,
                   {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_,
                    tr_min_cadence_, tr_chosen_speed_, tr_lag_, tr_prev_speed_, tr_prev_phase_,
-                   tr_still_, tr_moving_, tr_counts_, reach_boost_});
+                   tr_still_, tr_moving_, tr_start_due_, tr_counts_, reach_boost_});
   contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, tr_time_,
                 pl.gait_weight, pl.playback_rate, tr_rate_, pl.layer_time_s,
                 {{pl.plant[0], pl.plant[1]},

@@ -582,6 +582,7 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       st.min_cadence[slot] = 0.0f;
       st.rate[slot] = 1.0f;
       st.still_s[slot] = st.moving_s[slot] = 0.0f;
+      st.start_due[slot] = 0;
       st.prev_speed_m_s[slot] = v;
       st.prev_phase[slot] = phase[slot];
       return;
@@ -611,11 +612,18 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       st.min_cadence[slot] = 0.0f;
     }
     if (stop_seen) ++counts[kStopsSeen];
-    if (start_seen) {
-      ++counts[kStartsSeen];
-      // Played unless a stop is still playing or fading out (one waiting for its phase gives way).
+    if (start_seen) ++counts[kStartsSeen];
+    // A start seen as a stop faded out begins once it has gone, unless the agent stands again.
+    uint8_t& start_due = st.start_due[slot];
+    if (stand) start_due = 0;
+    const bool start_late = start_due != 0 && stage == TransitionStage::kNone;
+    if (start_seen || start_late) {
+      // Played unless a stop is still playing or fading out (one waiting for its phase gives
+      // way); then as soon as it has gone, from where the clip moves as fast as the agent.
       const int k = play ? nearest_transition(lib, TransitionKind::kStart, v) : -1;
-      if (k >= 0 && (stage == TransitionStage::kNone || stage == TransitionStage::kWaiting)) {
+      const bool free = stage == TransitionStage::kNone || stage == TransitionStage::kWaiting;
+      start_due = k >= 0 && !free ? 1 : 0;
+      if (k >= 0 && free) {
         const Transition& tr = lib.transitions[k];
         index = static_cast<int16_t>(k);
         stage = TransitionStage::kPlaying;

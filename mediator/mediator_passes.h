@@ -272,6 +272,9 @@ struct TransitionState {
   std::span<float> lag_m;  // playing: the agent's distance travelled minus the clip's [m]
   std::span<float> prev_speed_m_s, prev_phase;
   std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
+  // 1: a start seen while a stop still played (the agent set off again as it faded out), to
+  // begin once the stop has gone.
+  std::span<uint8_t> start_due;
   std::span<uint32_t> counts;          // [slot * kNumCounts + TransitionCount], cumulative
   std::span<const float> rate_boost = {};  // the rate pass's reach factor (ReachInput; empty: 1)
 };
@@ -284,7 +287,8 @@ inline constexpr float kStopDeceleration = 0.3f;
 // Reads the filtered speed, `standing`, the layers and phase, and last frame's transition state.
 // Counts starts (speed rising past the stop speed after standing kTransitionSettle) and stops
 // (falling below it after moving as long). In APM, with a library that has them, plays them: a
-// start as the agent starts, from the clip time where the clip moves as fast as the agent; a stop
+// start as the agent starts, from the clip time where the clip moves as fast as the agent (or,
+// seen while a stop still plays or fades out, as soon as that has gone); a stop
 // once the speed falls fast enough to come to rest within the clip's own stopping time, entered
 // where the clip has slowed to the agent's speed or later (where the agent can still play it and
 // come to rest in time; of those, the one whose gait phase comes soonest) and begun when the

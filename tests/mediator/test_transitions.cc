@@ -37,6 +37,10 @@ glm::vec2 stopping(double t) {
   return {0.0f, static_cast<float>(1.1 * (1.0 - u * u * (3.0 - 2.0 * u)))};
 }
 
+// Comes to rest as `stopping` does, stands 0.3 s and sets off again as `starting` does: it stands
+// for less time than the stop clip takes to settle and fade out.
+glm::vec2 stop_and_go(double t) { return t < 3.5 ? stopping(t) : starting(t - 2.5); }
+
 struct Played {
   MetricsReport report;
   std::array<uint64_t, kNumCounts> counts{};
@@ -251,9 +255,11 @@ TEST(Transitions, AChosenStopIsKeptThroughASpeedBumpBelowTheSpeedItWasChosenAt) 
   std::vector<TransitionStage> stage{TransitionStage::kNone};
   std::vector<float> time{0}, weight{0}, tr_rate{1}, waited{0}, min_cadence{0}, chosen{0}, lag{0},
       prev_speed{0}, prev_phase{0}, still{0}, moving{0};
+  std::vector<uint8_t> start_due{0};
   std::vector<uint32_t> counts(kNumCounts, 0);
-  const TransitionState state{index,  stage, time,       weight,     tr_rate, waited, min_cadence,
-                              chosen, lag,   prev_speed, prev_phase, still,   moving, counts};
+  const TransitionState state{index,      stage,      time,  weight, tr_rate,   waited,
+                              min_cadence, chosen,    lag,   prev_speed, prev_phase, still,
+                              moving,     start_due, counts};
   // The gait phase stands still: the stop's own phase never comes, so it waits.
   auto step = [&](float v) {
     speed[0] = v;
@@ -308,6 +314,26 @@ TEST(Transitions, AnAgentComingToRestPlaysTheStopClip) {
   auto lib = start_stop_library();
   ASSERT_TRUE(lib.ok()) << lib.message();
   expect_one_played(play(*lib, stopping, 300), kStop);
+}
+
+// An agent that sets off again while the stop it played still fades out plays the start once the
+// stop has gone (it was left out: a start was played only when no stop played).
+TEST(Transitions, AStartSeenAsAStopFadesOutIsPlayedAfterIt) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_31_start_walk_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const Played p = play(*lib, stop_and_go, 420);
+  EXPECT_EQ(p.counts[kStopsSeen], 1u);
+  EXPECT_EQ(p.counts[kStopsPlayed], 1u);
+  EXPECT_EQ(p.counts[kStartsSeen], 1u);
+  EXPECT_EQ(p.counts[kStartsPlayed], 1u);
+  EXPECT_GT(p.frames_with[kStart], 20);
+  EXPECT_FLOAT_EQ(p.max_weight[kStart], 1.0f);
+  EXPECT_LE(p.report.root_error_cm.mean, 3.0);
+  EXPECT_LE(p.report.feet.support_slide_cm_s, 2.0);
+  EXPECT_EQ(p.report.playback_outside_limits, 0.0);
+  EXPECT_EQ(p.pops, 0);
 }
 
 // The same library with its transitions taken away: starts and stops are counted, none is played,
