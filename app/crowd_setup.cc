@@ -95,7 +95,7 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
       "--scenario", o->scenario,
       "Scenario name (data/scenarios, or $GAITKEEPER_SCENARIOS), a scenario .json file, "
       "or a trajectory file to replay (.txt, .csv, .tsv or .dat: ETH/UCY's frame id x y, the ETH "
-      "authors' 8-column obsmat.txt, or CSV with a header naming frame, id, x and y)");
+      "authors' 8-column obsmat.txt, or CSV with a header naming frame or time, id, x and y)");
   if (scenario_required) scenario->required();
   cmd->add_option("--sim", o->sim, "Crowd simulator: social (default) or detour");
   cmd->add_option("--agents", o->agents,
@@ -106,7 +106,8 @@ void add_crowd_options(CLI::App* cmd, CrowdOptions* o, bool scenario_required) {
                   "Worker threads of the simulator, mediator and pose passes (1 = single-threaded, "
                   "default; 0 = all cores)");
   cmd->add_option("--trajectory-frame-time", o->trajectory_frame_time,
-                  "Seconds between two samples of a replayed trajectory (default 0.4)");
+                  "Seconds between two samples of a replayed trajectory (default 0.4; a CSV "
+                  "whose header names a time column is replayed at its times)");
   cmd->add_option("--mode", o->mode,
                   "naive (nearest clip at native rate), rate (speed-matched playback only) or "
                   "apm (the whole mediator; default)");

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <tuple>
 
@@ -107,8 +108,11 @@ Status parse_number(std::string_view token, const std::string& column, const std
 constexpr const char* kLayouts =
     "expected 4 numbers (frame id x y) or 8 (ETH obsmat: frame id pos_x pos_z pos_y v_x v_z v_y)";
 constexpr const char* kHeaderNames =
-    "a header names the columns frame (or frame_id), id (or ped, ped_id, agent_id, track_id, "
-    "person_id), x (or pos_x) and y (or pos_y)";
+    "a header names the columns frame (or frame_id; or time, t or timestamp in seconds), id (or "
+    "ped, ped_id, agent_id, track_id, person_id), x (or pos_x) and y (or pos_y)";
+// A time column [s] is read to the millisecond: its rows become frames of this length.
+constexpr double kTimeQuantum_s = 1e-3;
+constexpr double kMaxTime_s = 1e7;
 constexpr int kMaxColumns = 64;
 
 // The file's layout: its separator, its column count and where frame, id, x and y are.
@@ -116,7 +120,8 @@ struct Layout {
   Separator sep = Separator::kBlank;
   int columns = 0;  // 0 until the first row sets it
   bool header = false;
-  int at[4] = {0, 1, 2, 3};  // frame, id, x, y
+  bool timed = false;        // at[0] is a time column [s] rather than frame numbers
+  int at[4] = {0, 1, 2, 3};  // frame (or time), id, x, y
   std::string names[4] = {"column 1 (frame)", "column 2 (id)", "column 3 (x)", "column 4 (y)"};
 };
 
@@ -130,7 +135,7 @@ std::string normalised_name(std::string_view t) {
   return n;
 }
 
-// Which of frame (0), id (1), x (2), y (3) a header name stands for; -1 for none.
+// Which of frame (0), id (1), x (2), y (3) or time (4) a header name stands for; -1 for none.
 int header_role(const std::string& n) {
   static const std::pair<const char*, int> kNames[] = {
       {"frame", 0},       {"frameid", 0},  {"framenumber", 0}, {"framenum", 0},
@@ -139,7 +144,8 @@ int header_role(const std::string& n) {
       {"track", 1},       {"trackid", 1},  {"person", 1},      {"personid", 1},
       {"objectid", 1},    {"objid", 1},    {"x", 2},           {"posx", 2},
       {"positionx", 2},   {"xm", 2},       {"y", 3},           {"posy", 3},
-      {"positiony", 3},   {"ym", 3}};
+      {"positiony", 3},   {"ym", 3},       {"t", 4},           {"time", 4},
+      {"times", 4},       {"timestamp", 4}, {"seconds", 4},    {"sec", 4}};
   for (const auto& [name, role] : kNames) {
     if (n == name) return role;
   }
@@ -154,7 +160,7 @@ Status parse_header(const std::string_view* tokens, int count, const std::string
                           "header: at most " + std::to_string(kMaxColumns) + " columns, found " +
                               std::to_string(count));
   }
-  int found[4] = {-1, -1, -1, -1};
+  int found[5] = {-1, -1, -1, -1, -1};
   for (int c = 0; c < count; ++c) {
     const int role = header_role(normalised_name(tokens[c]));
     if (role < 0) continue;
@@ -167,7 +173,12 @@ Status parse_header(const std::string_view* tokens, int count, const std::string
     }
     found[role] = c;
   }
-  static constexpr const char* kWhat[4] = {"frame", "id", "x", "y"};
+  // A time column, when there is one, times the rows (a frame number says less).
+  if (found[4] >= 0) {
+    found[0] = found[4];
+    layout->timed = true;
+  }
+  static constexpr const char* kWhat[4] = {"frame (or time)", "id", "x", "y"};
   for (int r = 0; r < 4; ++r) {
     if (found[r] < 0) {
       std::string names;
@@ -241,7 +252,14 @@ Status parse_row(std::string_view text_row, const std::string& file, int line, L
     GK_RETURN_IF_ERROR(parse_number(tokens[layout->at[r]], layout->names[r], file, line, &values[r]));
   }
   const std::string_view frame_token = tokens[layout->at[0]], id_token = tokens[layout->at[1]];
-  if (values[0] < 0.0 || values[0] > kMaxFrame || values[0] != std::floor(values[0])) {
+  if (layout->timed) {
+    if (std::abs(values[0]) > kMaxTime_s) {
+      return Status::AtLine(file, line,
+                            layout->names[0] + ": expected a time within +-1e7 s, found " +
+                                quoted_snippet(frame_token));
+    }
+    values[0] = std::round(values[0] / kTimeQuantum_s);
+  } else if (values[0] < 0.0 || values[0] > kMaxFrame || values[0] != std::floor(values[0])) {
     return Status::AtLine(file, line,
                           layout->names[0] + ": expected a whole number in [0, 2^31), found " +
                               quoted_snippet(frame_token));
@@ -334,13 +352,20 @@ Result<TrajectoryTable> parse_trajectory_text(std::string_view text, const std::
   }
   if (duplicate_line != std::numeric_limits<int>::max()) {
     const Row& dup = rows[duplicate_index];
+    char when[64];
+    if (layout.timed) {
+      std::snprintf(when, sizeof(when), "time %.3f s", static_cast<double>(dup.frame) * kTimeQuantum_s);
+    } else {
+      std::snprintf(when, sizeof(when), "frame %lld", static_cast<long long>(dup.frame));
+    }
     return Status::AtLine(file_name, dup.line,
-                          "duplicate row for frame " + std::to_string(dup.frame) + ", pedestrian " +
+                          "duplicate row for " + std::string(when) + ", pedestrian " +
                               std::to_string(dup.id) + " (first at line " +
                               std::to_string(rows[duplicate_index - 1].line) + ")");
   }
 
   TrajectoryTable table;
+  table.seconds_per_frame = layout.timed ? kTimeQuantum_s : 0.0;
   table.frame_step = usual_frame_step(rows);
   table.first_frame = rows[0].frame;
   table.frames.reserve(rows.size());

@@ -25,6 +25,9 @@ struct TrajectoryTable {
   // pedestrian; 1 when no pedestrian has two samples. [frames] [> 0]
   int64_t frame_step = 1;
   int64_t first_frame = 0;  // smallest frame number in the file
+  // A file with a time column: the seconds one of `frames` stands for (its times, to the
+  // millisecond); 0: frame numbers, timed by ReplayOptions::frame_time_s.
+  double seconds_per_frame = 0.0;
   size_t num_tracks() const { return ped_ids.size(); }
 };
 

@@ -320,8 +320,13 @@ Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(
   if (out_pedestrian_ids) *out_pedestrian_ids = table->ped_ids;  // sorted: tracks are by id
   const size_t slash = path.find_last_of('/');
   std::string name = "replay " + (slash == std::string::npos ? path : path.substr(slash + 1));
-  return std::unique_ptr<CrowdSource>(new TrajectoryReplay(
-      std::move(name), *table, static_cast<double>(options.frame_time_s), options.loop));
+  // A file that gives its times is replayed at them: frame_time_s is for frame numbers.
+  const double frame_time_s =
+      table->seconds_per_frame > 0.0
+          ? table->seconds_per_frame * static_cast<double>(table->frame_step)
+          : static_cast<double>(options.frame_time_s);
+  return std::unique_ptr<CrowdSource>(
+      new TrajectoryReplay(std::move(name), *table, frame_time_s, options.loop));
 }
 
 }  // namespace gk

@@ -2,8 +2,8 @@
 // Replay of recorded pedestrian trajectories in the ETH/UCY text format (frame, id, x, y per line,
 // tab or space separated; or the ETH authors' obsmat.txt, frame id pos_x pos_z pos_y v_x v_z v_y,
 // whose ground plane is (pos_x, pos_y)), or as CSV (comma or semicolon separated), with or without
-// a header row that names the frame, id, x and y columns (in any order, among others); lines
-// beginning with '#' are comments. Positions are resampled smoothly (C1: no velocity jumps) to the
+// a header row that names the frame (or time, in seconds), id, x and y columns (in any order,
+// among others); lines beginning with '#' are comments. Positions are resampled smoothly (C1: no velocity jumps) to the
 // simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
 // is ignored: the data is the truth.
 //
@@ -36,6 +36,7 @@ struct ReplayOptions {
   // Seconds between two consecutive samples of one pedestrian, a sample step being the file's
   // usual difference between consecutive frame numbers (10 in the ETH/UCY files). [s] [> 0]
   // Note: biwi_eth.txt is resampled from 6-frame annotations; its 10-id step spans ~0.667 s.
+  // Not used for a file whose header names a time column: its rows are replayed at their times.
   float frame_time_s = 0.4f;
   // Play the file again and again: one sample step after its last sample, it starts over from its
   // first frame (time_s() keeps counting). Every pedestrian leaves before the file starts over,

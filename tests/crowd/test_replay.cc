@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -397,6 +398,39 @@ TEST(TrajectoryReplay, CsvWithAHeaderReplaysAsTheEthUcyFile) {
   EXPECT_NEAR(named->frame().positions[0].y, 2.0f, 1e-5f);
 }
 
+// A CSV with a time column [s] is replayed at its times, whatever frame_time_s says: zara01's rows
+// with t = frame / 10 * 0.4 s replay as the file does at 0.4 s per 10 frames.
+TEST(TrajectoryReplay, ATimeColumnTimesTheRows) {
+  const char* rel = "trajectories/zara1/crowds_zara01.txt";
+  GK_REQUIRE_DATA(rel);
+  std::string timed = "ped_id,x,y,timestamp\n";
+  for (const RawRow& r : read_raw(test::data_path(rel))) {
+    char row[160];
+    std::snprintf(row, sizeof(row), "%ld,%.10g,%.10g,%.3f\n", r.id, r.x, r.y,
+                  static_cast<double>(r.frame) / kFramesPerSample * 0.4);
+    timed += row;
+  }
+  const std::string path = write_scratch("zara01_timed.csv", timed);
+  auto txt = load(test::data_path(rel), 0.4f);
+  auto csv = load(path, 1.7f);  // not used: the file gives its times
+  ASSERT_TRUE(txt && csv);
+  double worst = 0.0;
+  size_t compared = 0;
+  for (int frame = 0; frame < 60 * 90; ++frame) {
+    ASSERT_TRUE(txt->step(1.0f / 60.0f).ok());
+    ASSERT_TRUE(csv->step(1.0f / 60.0f).ok());
+    const AgentFrame a = txt->frame(), b = csv->frame();
+    ASSERT_EQ(a.size(), b.size()) << "at " << frame;
+    for (size_t i = 0; i < a.size(); ++i) {
+      ASSERT_EQ(a.ids[i], b.ids[i]);
+      worst = std::max(worst, double(glm::length(a.positions[i] - b.positions[i])));
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 20000u);
+  EXPECT_LT(worst, 1e-4);  // the same samples at the same times (float rounding apart)
+}
+
 // A header or CSV row that cannot be read names the line and what was expected.
 TEST(TrajectoryReplay, MalformedCsvNamesLineAndColumn) {
   const struct {
@@ -405,6 +439,9 @@ TEST(TrajectoryReplay, MalformedCsvNamesLineAndColumn) {
     const char* what;
   } kCases[] = {
       {"frame,id,x\n0,1,2\n", 1, "header: no column for y among 'frame', 'id', 'x'"},
+      {"id,x,y\n0,1,2\n", 1, "header: no column for frame (or time) among 'id', 'x', 'y'"},
+      {"t,id,x,y\n1e9,1,2,3\n", 2, "column 1 (t): expected a time within +-1e7 s, found '1e9'"},
+      {"t,id,x,y\n0.5,1,2,3\n0.5004,1,2,3\n", 3, "duplicate row for time 0.500 s, pedestrian 1"},
       {"frame,id,x,pos_x,y\n", 1, "header: columns 3 ('x') and 4 ('pos_x') name the same"},
       {"\n# c\nframe;id;x;y\n0;1;2;3\n10;1;2\n", 5, "expected 4 fields as the header names, found 3"},
       {"frame,id,x,y\n0,1,,3\n", 2, "column 3 (x): expected a number, found ''"},
