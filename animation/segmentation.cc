@@ -312,24 +312,48 @@ TakeSegmentation segment_take(const Clip& take, const Skeleton& sk, const ClipAn
     out.segments.push_back(seg);
   }
 
-  // Cycles: in each steady segment, the stride inside it whose ends match best.
+  // Cycles: in each steady segment, one per pace it walks or runs at, the stride whose ends
+  // match best. Strides of one pace differ in speed as little as a steady stride's two halves
+  // may (th.steady_speed_change): a take that walks, then walks faster, gives both.
   for (TakeSegment& seg : out.segments) {
     if (seg.kind != SegmentKind::kSteady) continue;
-    float best = 1e30f;
+    std::vector<int> inside;
     for (size_t i = 0; i < out.strides.size(); ++i) {
       const Stride& st = out.strides[i];
-      if (!st.steady || st.span.start_s < seg.span.start_s - 0.5f / fps ||
-          st.span.end_s > seg.span.end_s + 0.5f / fps) {
-        continue;
-      }
-      const float cost =
-          seam_cost(take, frame_at(st.span.start_s, fps, n), frame_at(st.span.end_s, fps, n));
-      if (cost < best) {
-        best = cost;
-        seg.cycle = static_cast<int>(i);
+      if (st.steady && st.span.start_s >= seg.span.start_s - 0.5f / fps &&
+          st.span.end_s <= seg.span.end_s + 0.5f / fps) {
+        inside.push_back(static_cast<int>(i));
       }
     }
-    if (seg.cycle >= 0) out.cycles.push_back(seg.cycle);
+    std::stable_sort(inside.begin(), inside.end(), [&](int a_i, int b_i) {
+      return out.strides[a_i].speed_m_s < out.strides[b_i].speed_m_s;
+    });
+    float best_all = 1e30f;
+    for (size_t from = 0; from < inside.size();) {
+      const float slowest = out.strides[inside[from]].speed_m_s;
+      size_t to = from;
+      while (to < inside.size() &&
+             out.strides[inside[to]].speed_m_s <= slowest * (1.0f + th.steady_speed_change)) {
+        ++to;
+      }
+      int pick = -1;
+      float best = 1e30f;
+      for (size_t k = from; k < to; ++k) {
+        const Stride& st = out.strides[inside[k]];
+        const float cost =
+            seam_cost(take, frame_at(st.span.start_s, fps, n), frame_at(st.span.end_s, fps, n));
+        if (cost < best) {
+          best = cost;
+          pick = inside[k];
+        }
+      }
+      out.cycles.push_back(pick);
+      if (best < best_all) {  // the segment's own loop: the best seam of all its paces
+        best_all = best;
+        seg.cycle = pick;
+      }
+      from = to;
+    }
   }
   if (out.cycles.empty() && (!out.strides.empty() || !out.steps.empty())) {
     int least = -1;

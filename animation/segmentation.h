@@ -2,9 +2,9 @@
 // Long takes: what a capture does over time. A take is cut into strides (one foot's contact start
 // to its next), each stride measured (speed, how much it speeds up or slows down, how far the body
 // turns), and the take into segments: standing (idle), starting, steady walking or running,
-// turning, stopping. From each steady segment one stride is cut out as a loop (its seam
+// turning, stopping. From each steady segment one stride per pace is cut out as a loop (its seam
 // cross-faded with the neighbouring stride, its turn spread out so the loop travels straight):
-// the cycles a blend space is made of. Starts, stops and turns stay available as transitions.
+// the cycles a blend space is made of (a take that walks, then walks faster, gives both). Starts, stops and turns stay available as transitions.
 
 #include <array>
 #include <string>
@@ -36,7 +36,9 @@ struct TakeSegment {
   float speed_in_m_s = 0.0f;   // smoothed root speed where it begins
   float speed_out_m_s = 0.0f;  // and where it ends
   float turn_rad = 0.0f;    // facing change over the segment (+: left)
-  int cycle = -1;           // steady segment: the stride cut out as its loop (index into strides)
+  // Steady segment: the stride cut out as its loop (index into strides), of its paces the one
+  // whose ends match best (every pace's loop is in TakeSegmentation::cycles).
+  int cycle = -1;
 };
 
 // Thresholds of the segmentation, from how people walk (see GAIT.md): in steady gait the two
@@ -55,8 +57,10 @@ struct SegmentationThresholds {
 struct TakeSegmentation {
   std::vector<Stride> strides;  // sorted by start
   std::vector<TakeSegment> segments;  // cover the take, in time order
-  // Strides cut out as loops: one per steady segment; when no stride is steady, the least
-  // unsteady one (and `problems` says so).
+  // Strides cut out as loops: in each steady segment one per pace (its steady strides grouped by
+  // speed, a group spanning no more than SegmentationThresholds::steady_speed_change of its
+  // slowest), the one whose ends match best; when no stride is steady, the least unsteady one
+  // (and `problems` says so).
   std::vector<int> cycles;
   bool fallback_cycle = false;  // `cycles` holds the least unsteady stride, not a steady one
   // Steps: one foot's contact start to the other foot's next (`side`: the first foot), measured

@@ -152,6 +152,54 @@ TEST(Segmentation, CyclesAreOneStrideLong) {
   }
 }
 
+// A take that walks and then walks faster, with no stop between (subject 16's walk followed by
+// its fast walk, the second's root carried on from where the first ends: one steady segment),
+// gives a loop at each pace, at PROVENANCE.md's speeds within 5%; each one stride long.
+TEST(Segmentation, ATakeAtTwoPacesGivesALoopAtEach) {
+  const char* walk_file = "clips/bvh/more/cmu_16_15_walk_mrl30.bvh";
+  const char* fast_file = "clips/bvh/more/cmu_16_22_fast_walk_mrl30.bvh";
+  REQUIRE_TAKE(walk_file);
+  REQUIRE_TAKE(fast_file);
+  Result<ClipSet> walk = load_clip_file(test::data_path(walk_file));
+  Result<ClipSet> fast = load_clip_file(test::data_path(fast_file));
+  ASSERT_TRUE(walk.ok() && fast.ok());
+  Clip take = walk->clips.at(0);
+  const Clip& more = fast->clips.at(0);
+  ASSERT_EQ(take.num_joints, more.num_joints);
+  ASSERT_EQ(take.fps, more.fps);
+  const size_t J = static_cast<size_t>(take.num_joints);
+  const glm::vec3 end = take.translations[(take.num_frames - 1) * J];
+  const glm::vec3 start = more.translations[0];
+  for (int f = 0; f < more.num_frames; ++f) {
+    take.rotations.insert(take.rotations.end(), more.frame_rotations(f), more.frame_rotations(f) + J);
+    std::vector<glm::vec3> tr(more.frame_translations(f), more.frame_translations(f) + J);
+    tr[0].x += end.x - start.x;
+    tr[0].z += end.z - start.z;
+    take.translations.insert(take.translations.end(), tr.begin(), tr.end());
+  }
+  take.num_frames += more.num_frames;
+  const Skeleton& sk = *walk->skeleton;
+  const ClipAnalysis a = analyze_clip(take, sk);
+  const TakeSegmentation seg = segment_take(take, sk, a);
+  int steady = 0;
+  for (const TakeSegment& s : seg.segments) steady += s.kind == SegmentKind::kSteady ? 1 : 0;
+  EXPECT_EQ(steady, 1);
+  ASSERT_EQ(seg.cycles.size(), 2u);
+  std::vector<float> speeds;
+  for (int ci : seg.cycles) {
+    const Stride& st = seg.strides[ci];
+    speeds.push_back(st.speed_m_s);
+    const Clip loop = extract_cycle(take, sk, a, st);
+    const ClipAnalysis la = analyze_clip(loop, sk);
+    EXPECT_EQ(la.contacts[0].size(), 1u);
+    EXPECT_EQ(la.contacts[1].size(), 1u);
+    EXPECT_NEAR(la.native_speed_m_s, st.speed_m_s, 0.05f * st.speed_m_s);
+  }
+  std::sort(speeds.begin(), speeds.end());
+  EXPECT_NEAR(speeds[0], 1.17f, 0.05f * 1.17f);  // PROVENANCE.md: the walk's average root speed
+  EXPECT_NEAR(speeds[1], 1.73f, 0.05f * 1.73f);  // and the fast walk's
+}
+
 // The loop's seam adds no step the take did not have: for every joint, the change of its local
 // rotation from the loop's last frame to its first is at most the larger of the take's own step
 // there (the stride's last frame to the next) and the loop's largest step elsewhere, plus its share
