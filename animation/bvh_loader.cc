@@ -421,6 +421,11 @@ Result<ClipSet> parse_bvh(std::string_view text, const std::string& source_name,
     set.rig_reason = "IK-style feet attached to the legs: " + moved;
     GK_RETURN_IF_ERROR(validate_skeleton(*set.skeleton, source_name));
   }
+  if (std::string added = add_end_site_toes(&set); !added.empty()) {
+    set.rig_reason += (set.rig_reason.empty() ? "" : "; ") + std::string("feet without toes: ") +
+                      added;
+    GK_RETURN_IF_ERROR(validate_skeleton(*set.skeleton, source_name));
+  }
   return set;
 }
 

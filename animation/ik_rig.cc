@@ -3,6 +3,7 @@
 
 #include "animation/ik_rig.h"
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <queue>
@@ -143,6 +144,63 @@ std::string attach_ik_feet(ClipSet* set) {
   }
   set->skeleton = std::move(s);
   return what;
+}
+
+std::string add_end_site_toes(ClipSet* set) {
+  if (!set || !set->skeleton || set->mesh) return "";
+  const Skeleton& old = *set->skeleton;
+  const int n = old.num_joints();
+  if (old.end_sites.size() != static_cast<size_t>(n)) return "";
+  constexpr float kMinFoot = 0.02f;  // [m] an End Site this close to the ankle is no foot
+  std::vector<int> feet;
+  for (int s = 0; s < 2; ++s) {
+    const Side sd = static_cast<Side>(s);
+    const int ankle = old.ankle(sd);
+    if (ankle < 0 || old.toe(sd) >= 0) continue;
+    bool leaf = true;
+    for (int j = 0; j < n; ++j) leaf = leaf && old.parents[j] != ankle;
+    if (leaf && glm::length(old.end_sites[ankle]) >= kMinFoot) feet.push_back(ankle);
+  }
+  if (feet.empty()) return "";
+  auto s = std::make_shared<Skeleton>(old);
+  std::string done;
+  std::vector<glm::vec3> offsets;
+  for (int ankle : feet) {
+    std::string name = old.names[ankle] + "_tip";
+    while (std::find(s->names.begin(), s->names.end(), name) != s->names.end()) name += "_";
+    s->names.push_back(name);
+    s->parents.push_back(static_cast<int16_t>(ankle));
+    s->rest_translations.push_back(old.end_sites[ankle]);
+    s->rest_rotations.push_back(glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+    s->end_sites[ankle] = glm::vec3(0.0f);  // the bone now ends at its toe joint
+    s->end_sites.push_back(glm::vec3(0.0f));
+    const int toe = s->num_joints() - 1;
+    const bool left = ankle == old.ankle(Side::kLeft);
+    s->roles[static_cast<int>(left ? JointRole::kLeftToe : JointRole::kRightToe)] =
+        static_cast<int16_t>(toe);
+    offsets.push_back(old.end_sites[ankle]);
+    done += (done.empty() ? "" : ", ") + name + " at the End Site of " + old.names[ankle];
+  }
+  const int m = s->num_joints();
+  for (Clip& c : set->clips) {
+    std::vector<glm::quat> rot;
+    std::vector<glm::vec3> trans;
+    rot.reserve(static_cast<size_t>(c.num_frames) * m);
+    trans.reserve(static_cast<size_t>(c.num_frames) * m);
+    for (int f = 0; f < c.num_frames; ++f) {
+      rot.insert(rot.end(), c.frame_rotations(f), c.frame_rotations(f) + n);
+      trans.insert(trans.end(), c.frame_translations(f), c.frame_translations(f) + n);
+      for (const glm::vec3& o : offsets) {
+        rot.emplace_back(1.0f, 0.0f, 0.0f, 0.0f);
+        trans.push_back(o);
+      }
+    }
+    c.rotations = std::move(rot);
+    c.translations = std::move(trans);
+    c.num_joints = m;
+  }
+  set->skeleton = std::move(s);
+  return done;
 }
 
 }  // namespace gk

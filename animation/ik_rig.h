@@ -20,4 +20,12 @@ namespace gk {
 // ("foot_l under calf_l (was under root)"), or "" when the legs already are chains.
 std::string attach_ik_feet(ClipSet* set);
 
+// Feet without toe joints (the foot ends a chain at an End Site, as many BVH rigs have it): each
+// such foot gets a toe joint at its End Site, fixed to the foot (no channels of its own), that
+// takes the toe role, so the leg is a full hip -> knee -> ankle -> toe chain and the foot rolls
+// about its tip. Only where the ankle role is found, the toe role is not, the foot has no child
+// joint and its End Site is at least 2 cm away. Returns what was done ("LeftFoot_tip at the End
+// Site of LeftFoot"), or "".
+std::string add_end_site_toes(ClipSet* set);
+
 }  // namespace gk

@@ -387,6 +387,84 @@ TEST(Invariance, UnitsAndPositionChannelsThroughBvh) {
   }
 }
 
+// The rig without toe joints: each toe removed, the foot ending at an End Site where the toe's own
+// bone ended in the rest pose, its tip (a rig whose feet end a chain, as many BVH exports have).
+glm::vec3 rest_tip(const Skeleton& sk, Side s) {
+  const int toe = sk.toe(s);
+  const glm::vec3 end =
+      toe < static_cast<int>(sk.end_sites.size()) ? sk.end_sites[toe] : glm::vec3(0.0f);
+  return sk.rest_translations[toe] + sk.rest_rotations[toe] * end;
+}
+Rig without_toes(const Rig& r) {
+  const Skeleton& sk = *r.sk;
+  const int n = sk.num_joints();
+  std::vector<int> new_of_old(n, -1);
+  std::vector<bool> drop(n, false);
+  for (Side s : {Side::kLeft, Side::kRight}) drop[sk.toe(s)] = true;
+  auto out = std::make_shared<Skeleton>();
+  for (int j = 0; j < n; ++j) {
+    if (drop[j]) continue;
+    new_of_old[j] = out->num_joints();
+    out->names.push_back(sk.names[j]);
+    out->parents.push_back(static_cast<int16_t>(sk.parents[j] < 0 ? -1 : new_of_old[sk.parents[j]]));
+    out->rest_translations.push_back(sk.rest_translations[j]);
+    out->rest_rotations.push_back(sk.rest_rotations[j]);
+    out->end_sites.push_back(j < static_cast<int>(sk.end_sites.size()) ? sk.end_sites[j]
+                                                                        : glm::vec3(0.0f));
+  }
+  for (Side s : {Side::kLeft, Side::kRight}) {
+    out->end_sites[new_of_old[sk.ankle(s)]] = rest_tip(sk, s);
+  }
+  detect_joint_roles(out.get());
+  Rig back{out, r.clip};
+  back.clip.num_joints = out->num_joints();
+  back.clip.rotations.clear();
+  back.clip.translations.clear();
+  for (int f = 0; f < r.clip.num_frames; ++f) {
+    for (int j = 0; j < n; ++j) {
+      if (drop[j]) continue;
+      back.clip.rotations.push_back(r.clip.frame_rotations(f)[j]);
+      back.clip.translations.push_back(r.clip.frame_translations(f)[j]);
+    }
+  }
+  return back;
+}
+
+// 5a. Feet without toes, through BVH: loaded, each foot gets a toe joint at its End Site, on
+// every frame where the removed toe's tip would be with the toe held straight; the analysis finds
+// the same speed, contacts (within two frames: the foot rolls off its rigid end, not off a toe
+// that bends) and cycle.
+TEST(Invariance, FeetWithoutToesThroughBvh) {
+  for (const Case& c : {kTakes[0], kTakes[1], kTakes[2], kLoop}) {
+    GK_REQUIRE_DATA(c.file);
+    const Rig r = load_rig(c.file);
+    const Rig bare = without_toes(r);
+    ASSERT_LT(bare.sk->toe(Side::kLeft), 0) << c.file;
+    const std::string text = format_bvh(*bare.sk, bare.clip, {1.0f, false});
+    Result<ClipSet> set = parse_bvh(text, std::string(c.file) + " without toes");
+    ASSERT_TRUE(set.ok()) << set.message();
+    EXPECT_NE(set->rig_reason.find("feet without toes"), std::string::npos) << set->rig_reason;
+    const Rig back{std::make_shared<Skeleton>(*set->skeleton), set->clips.at(0)};
+    ASSERT_TRUE(back.sk->has_locomotion_roles()) << c.file;
+    ASSERT_EQ(back.clip.num_frames, r.clip.num_frames);
+    std::vector<glm::mat4> m0(r.sk->num_joints()), m1(back.sk->num_joints());
+    float worst = 0.0f;
+    for (int f = 0; f < r.clip.num_frames; ++f) {
+      clip_frame_model(r.clip, *r.sk, f, m0);
+      clip_frame_model(back.clip, *back.sk, f, m1);
+      for (Side s : {Side::kLeft, Side::kRight}) {
+        const glm::vec3 tip(m0[r.sk->ankle(s)] * glm::vec4(rest_tip(*r.sk, s), 1.0f));
+        worst = std::max(worst, glm::length(tip - translation_of(m1[back.sk->toe(s)])));
+      }
+    }
+    EXPECT_LT(worst, 1e-3f) << c.file << ": the toe joint is not at the foot's end";
+    Tolerance tol;
+    tol.contact_s = 2.0f / r.clip.fps;
+    tol.cycle_s = 2.0f / r.clip.fps;
+    expect_same(analyze(r), analyze(back), tol, std::string(c.file) + " without toes");
+  }
+}
+
 // 5b. Up axis: written as BVH by a tool whose up is +z (Blender, 3ds Max), +x or -z, rest
 // offsets and all, then loaded: the body is stood up along +y again and the analysis is the same.
 TEST(Invariance, UpAxisThroughBvh) {
