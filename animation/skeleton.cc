@@ -364,6 +364,19 @@ void detect_leg(Skeleton* s, const std::vector<NameInfo>& info, const std::vecto
     toe = ik_style_joint(*s, info, pos, Part::kToe, side, hip, ankle,
                          glm::length(pos[ankle] - pos[knee]));
   }
+  // A toe of any other name ("LeftFootToe", "LeftToe_End"): the ankle's child joint with the
+  // longest bone, the foot's own (a heel or helper joint beside it is shorter).
+  if (ankle >= 0 && toe < 0) {
+    float longest = 0.0f;
+    for (int j = ankle + 1; j < s->num_joints(); ++j) {
+      if (s->parents[j] != ankle) continue;
+      const float len = glm::length(pos[j] - pos[ankle]);
+      if (len > longest) {
+        longest = len;
+        toe = j;
+      }
+    }
+  }
   set_role(s, left ? JointRole::kLeftHip : JointRole::kRightHip, hip);
   set_role(s, left ? JointRole::kLeftKnee : JointRole::kRightKnee, knee);
   set_role(s, left ? JointRole::kLeftAnkle : JointRole::kRightAnkle, ankle);

@@ -171,6 +171,16 @@ TEST(SkeletonRoles, PlainPrefixAndSuffixNames) {
   detect_joint_roles(&words);
   EXPECT_EQ(role_joint(words, JointRole::kLeftKnee), "left_knee");
   EXPECT_EQ(role_joint(words, JointRole::kRightToe), "right_toes");
+  // A toe no name rule knows (a foot word in it, an "_End" suffix): the ankle's child joint.
+  for (const char* toe : {"%FootToe", "%Toe_End", "%Digits"}) {
+    Skeleton odd = biped("Hips", {"Spine"}, "Neck", "Head", {"%UpLeg", "%Leg", "%Foot", toe},
+                         {"%Arm"}, "Left", "Right");
+    detect_joint_roles(&odd);
+    std::string want = toe;
+    EXPECT_EQ(role_joint(odd, JointRole::kLeftToe), "Left" + want.substr(1)) << toe;
+    EXPECT_EQ(role_joint(odd, JointRole::kRightToe), "Right" + want.substr(1)) << toe;
+    EXPECT_EQ(role_joint(odd, JointRole::kLeftAnkle), "LeftFoot") << toe;
+  }
 }
 
 // A knee that is not below its hip is not a knee of that leg.
