@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -297,6 +298,41 @@ void TrajectoryReplay::update_live(float dt_s) {
 
 }  // namespace
 
+namespace {
+
+// Pedestrians walk at about 1.3 m/s. A file whose pedestrians would move implausibly fast or slow
+// in metres but at walking pace in centimetres or millimetres (trackers and lab datasets write
+// both) is in those units: the scale [m per file unit] and its name, or 1 for metres. Judged on
+// the median over pedestrians of each one's 75th-percentile speed between samples (standers and
+// tracker jitter count little), and only outside 0.15-6 m/s, so no file in metres is rescaled.
+std::pair<double, const char*> detect_position_unit(const TrajectoryTable& t,
+                                                    double frame_time_s) {
+  std::vector<double> typical;
+  for (size_t k = 0; k < t.num_tracks(); ++k) {
+    std::vector<double> v;
+    for (uint32_t i = t.track_begin[k] + 1; i < t.track_begin[k + 1]; ++i) {
+      const double dt = static_cast<double>(t.frames[i] - t.frames[i - 1]) /
+                        static_cast<double>(t.frame_step) * frame_time_s;
+      if (dt > 0.0) v.push_back(glm::length(t.positions[i] - t.positions[i - 1]) / dt);
+    }
+    if (v.size() < 2) continue;
+    std::nth_element(v.begin(), v.begin() + v.size() * 3 / 4, v.end());
+    typical.push_back(v[v.size() * 3 / 4]);
+  }
+  if (typical.empty()) return {1.0, "metres"};
+  std::nth_element(typical.begin(), typical.begin() + typical.size() / 2, typical.end());
+  const double speed = typical[typical.size() / 2];
+  auto plausible = [](double s) { return s >= 0.15 && s <= 6.0; };
+  if (plausible(speed) || !(speed > 0.0)) return {1.0, "metres"};
+  for (const auto& [scale, name] : {std::pair<double, const char*>{0.01, "centimetres"},
+                                    std::pair<double, const char*>{0.001, "millimetres"}}) {
+    if (plausible(speed * scale)) return {scale, name};
+  }
+  return {1.0, "metres"};
+}
+
+}  // namespace
+
 bool is_trajectory_file_name(std::string_view path) {
   const size_t dot = path.rfind('.');
   if (dot == std::string_view::npos || path.find('/', dot) != std::string_view::npos) return false;
@@ -325,6 +361,11 @@ Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(
       table->seconds_per_frame > 0.0
           ? table->seconds_per_frame * static_cast<double>(table->frame_step)
           : static_cast<double>(options.frame_time_s);
+  const auto [unit_m, unit_name] = detect_position_unit(*table, frame_time_s);
+  if (unit_m != 1.0) {
+    for (glm::vec2& p : table->positions) p *= static_cast<float>(unit_m);
+    name += std::string(" (in ") + unit_name + ", by its walking speeds)";
+  }
   return std::unique_ptr<CrowdSource>(
       new TrajectoryReplay(std::move(name), *table, frame_time_s, options.loop));
 }

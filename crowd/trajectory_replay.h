@@ -7,6 +7,9 @@
 // simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
 // is ignored: the data is the truth.
 //
+// Units: metres, unless the pedestrians would then move implausibly (their typical speed outside
+// 0.15-6 m/s) and centimetres or millimetres bring them to a walking pace; the replay's name then
+// says so ("replay x.csv (in millimetres, by its walking speeds)").
 // Coordinates: the file's ground (x, y) [m] becomes our ground (x, z) = (x, y) unchanged, so
 // distances, speeds and ids match the data; seen from above (+y) the scene is the mirror image of a
 // plot of the file with y up (a reflection, harmless for walking).

@@ -431,6 +431,52 @@ TEST(TrajectoryReplay, ATimeColumnTimesTheRows) {
   EXPECT_LT(worst, 1e-4);  // the same samples at the same times (float rounding apart)
 }
 
+// A file in centimetres or millimetres (zara01's rows times 100 and 1000) is recognised by its
+// pedestrians' walking speeds and replays as the file in metres; every shared file, in metres, is
+// read as metres.
+TEST(TrajectoryReplay, CentimetresAndMillimetresAreRecognisedByWalkingSpeeds) {
+  const char* rel = "trajectories/zara1/crowds_zara01.txt";
+  GK_REQUIRE_DATA(rel);
+  const std::vector<RawRow> raw = read_raw(test::data_path(rel));
+  auto txt = load(test::data_path(rel), 0.4f);
+  ASSERT_TRUE(txt);
+  EXPECT_EQ(txt->name().find("(in "), std::string::npos) << txt->name();
+  for (const auto& [scale, unit] : {std::pair<double, const char*>{100.0, "centimetres"},
+                                    std::pair<double, const char*>{1000.0, "millimetres"}}) {
+    std::string text;
+    for (const RawRow& r : raw) {
+      char row[160];
+      std::snprintf(row, sizeof(row), "%ld %ld %.6f %.6f\n", r.frame, r.id, r.x * scale,
+                    r.y * scale);
+      text += row;
+    }
+    auto scaled = load(write_scratch(std::string("zara01_") + unit + ".txt", text), 0.4f);
+    auto plain = load(test::data_path(rel), 0.4f);
+    ASSERT_TRUE(scaled && plain);
+    EXPECT_NE(scaled->name().find(unit), std::string::npos) << scaled->name();
+    double worst = 0.0;
+    for (int frame = 0; frame < 60 * 60; ++frame) {
+      ASSERT_TRUE(plain->step(1.0f / 60.0f).ok());
+      ASSERT_TRUE(scaled->step(1.0f / 60.0f).ok());
+      const AgentFrame a = plain->frame(), b = scaled->frame();
+      ASSERT_EQ(a.size(), b.size());
+      for (size_t i = 0; i < a.size(); ++i) {
+        worst = std::max(worst, double(glm::length(a.positions[i] - b.positions[i])));
+      }
+    }
+    EXPECT_LT(worst, 1e-3) << unit;
+  }
+  for (const char* other : {"trajectories/eth/biwi_eth.txt", "trajectories/hotel/biwi_hotel.txt",
+                            "trajectories/zara3/crowds_zara03.txt",
+                            "trajectories/eth/original/obsmat.txt",
+                            "trajectories/hotel/original/obsmat.txt"}) {
+    GK_REQUIRE_DATA(other);
+    auto r = load(test::data_path(other), 0.4f);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->name().find("(in "), std::string::npos) << other << ": " << r->name();
+  }
+}
+
 // A header or CSV row that cannot be read names the line and what was expected.
 TEST(TrajectoryReplay, MalformedCsvNamesLineAndColumn) {
   const struct {
