@@ -3,19 +3,17 @@
 #include "animation/clip_library.h"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <system_error>
 
 #include "animation/gltf_loader.h"
+#include "common/ascii.h"
 
 namespace gk {
 namespace {
 
 std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
+  return lower_ascii(std::filesystem::path(path).extension().string());
 }
 
 bool is_clip_extension(const std::string& ext) {

@@ -18,6 +18,7 @@
 #include "animation/ik_rig.h"
 #include "animation/loader_internal.h"
 #include "animation/mesh.h"
+#include "common/ascii.h"
 #include "common/file_io.h"
 #include "common/text_snippet.h"
 
@@ -450,8 +451,7 @@ Result<ClipSet> load_gltf(const std::string& path, const LoadOptions& options) {
   tinygltf::TinyGLTF loader;
   tinygltf::Model model;
   std::string err, warn;
-  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lower_ascii(path.size() >= 4 ? path.substr(path.size() - 4) : "");
   const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
                                 : loader.LoadASCIIFromFile(&model, &err, &warn, path);
   if (!ok) return tinygltf_error(path, err);

@@ -152,20 +152,19 @@ std::string add_end_site_toes(ClipSet* set) {
   const int n = old.num_joints();
   if (old.end_sites.size() != static_cast<size_t>(n)) return "";
   constexpr float kMinFoot = 0.02f;  // [m] an End Site this close to the ankle is no foot
-  std::vector<int> feet;
-  for (int s = 0; s < 2; ++s) {
-    const Side sd = static_cast<Side>(s);
+  std::vector<Side> feet;
+  for (Side sd : {Side::kLeft, Side::kRight}) {
     const int ankle = old.ankle(sd);
     if (ankle < 0 || old.toe(sd) >= 0) continue;
-    bool leaf = true;
-    for (int j = 0; j < n; ++j) leaf = leaf && old.parents[j] != ankle;
-    if (leaf && glm::length(old.end_sites[ankle]) >= kMinFoot) feet.push_back(ankle);
+    const bool leaf = std::find(old.parents.begin(), old.parents.end(), ankle) == old.parents.end();
+    if (leaf && glm::length(old.end_sites[ankle]) >= kMinFoot) feet.push_back(sd);
   }
   if (feet.empty()) return "";
   auto s = std::make_shared<Skeleton>(old);
   std::string done;
   std::vector<glm::vec3> offsets;
-  for (int ankle : feet) {
+  for (Side sd : feet) {
+    const int ankle = old.ankle(sd);
     std::string name = old.names[ankle] + "_tip";
     while (std::find(s->names.begin(), s->names.end(), name) != s->names.end()) name += "_";
     s->names.push_back(name);
@@ -175,8 +174,7 @@ std::string add_end_site_toes(ClipSet* set) {
     s->end_sites[ankle] = glm::vec3(0.0f);  // the bone now ends at its toe joint
     s->end_sites.push_back(glm::vec3(0.0f));
     const int toe = s->num_joints() - 1;
-    const bool left = ankle == old.ankle(Side::kLeft);
-    s->roles[static_cast<int>(left ? JointRole::kLeftToe : JointRole::kRightToe)] =
+    s->roles[static_cast<int>(sd == Side::kLeft ? JointRole::kLeftToe : JointRole::kRightToe)] =
         static_cast<int16_t>(toe);
     offsets.push_back(old.end_sites[ankle]);
     done += (done.empty() ? "" : ", ") + name + " at the End Site of " + old.names[ankle];

@@ -4,7 +4,8 @@
 // turns), and the take into segments: standing (idle), starting, steady walking or running,
 // turning, stopping. From each steady segment one stride per pace is cut out as a loop (its seam
 // cross-faded with the neighbouring stride, its turn spread out so the loop travels straight):
-// the cycles a blend space is made of (a take that walks, then walks faster, gives both). Starts, stops and turns stay available as transitions.
+// the cycles a blend space is made of (a take that walks, then walks faster, gives both). Starts,
+// stops and turns stay available as transitions.
 
 #include <array>
 #include <string>

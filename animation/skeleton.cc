@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common/ascii.h"
 #include "common/file_io.h"
 #include "common/json_text.h"
 #include "common/text_snippet.h"
@@ -54,11 +55,6 @@ struct NameInfo {
 
 bool is_separator(char c) { return c == '_' || c == '.' || c == '-' || c == ' '; }
 
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
 
 // Base words (separators removed) of each body part, from CMU/cgspeed, Mixamo, Rigify, Unity
 // humanoid, ASF (lfemur, ltibia) and plain (l_knee) conventions.
@@ -103,7 +99,7 @@ std::vector<std::string> words_of(std::string_view raw) {
   std::vector<std::string> words;
   std::string cur;
   auto flush = [&] {
-    if (!cur.empty()) words.push_back(lower(cur));
+    if (!cur.empty()) words.push_back(lower_ascii(cur));
     cur.clear();
   };
   for (size_t i = 0; i < raw.size(); ++i) {
@@ -174,7 +170,7 @@ NameInfo classify_by_words(std::string_view raw) {
 }
 
 NameInfo classify_plain(std::string_view raw) {
-  std::string n = lower(raw);
+  std::string n = lower_ascii(raw);
   // Namespaces (mixamorig:, rig|) and Rigify's deform prefix say nothing about the body part.
   if (size_t p = n.find_last_of(":|"); p != std::string::npos) n = n.substr(p + 1);
   if (n.rfind("def-", 0) == 0 || n.rfind("def_", 0) == 0) n = n.substr(4);

@@ -318,8 +318,8 @@ void add_analyze_clip_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "analyze-clip",
       "Analyse clips: unit scale, up axis (a Z-up or X-up BVH stood up along +y), IK-style feet "
-      "re-parented under the shins, native speed and "
-      "direction, gait cycle, foot contacts, foot-slide floor; a take's segments (idle, start, "
+      "re-parented under the shins (and a BVH foot without a toe joint given one at its End "
+      "Site), native speed and direction, gait cycle, foot contacts, foot-slide floor; a take's segments (idle, start, "
       "steady, turn, stop) and the loops cut from it (without a steady stride: its steadiest "
       "step and that step's mirror image).");
   cmd->add_option("files", opt->files,

@@ -1,7 +1,6 @@
 // The demo window's input: keys (Space pause, H help, R restart, Esc quit), the mouse (orbit,
 // pan, zoom toward the cursor, picking), and scripted input for tests (`--input`), which is fed to
 // Dear ImGui where the GLFW backend puts real input, so it takes the same path.
-#include <cctype>
 #include <cmath>
 #include <string>
 
@@ -9,13 +8,14 @@
 #include <imgui.h>
 
 #include "app/demo_app.h"
+#include "common/ascii.h"
 
 namespace gk::app {
 namespace {
 
 // "space", "escape", "enter", "tab" or a single letter or digit -> GLFW key code; -1 if unknown.
-int key_code(std::string name) {
-  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+int key_code(std::string_view key) {
+  const std::string name = lower_ascii(key);
   if (name == "space") return GLFW_KEY_SPACE;
   if (name == "escape" || name == "esc") return GLFW_KEY_ESCAPE;
   if (name == "enter") return GLFW_KEY_ENTER;

@@ -124,7 +124,8 @@ void DemoApp::panel_crowd() {
     ImGui::InputText("##trajectory", &replay_path_);
     help_marker(
         "A trajectory file: ETH/UCY .txt (frame id x y, or ETH's 8-column obsmat.txt), or CSV "
-        "(.csv, .tsv, .dat) with a header naming frame, id, x and y; e.g. "
+        "(.csv, .tsv, .dat) with a header naming frame (or time in seconds), id, x and y; "
+        "positions in cm or mm are recognised; e.g. "
         "../shared/data/trajectories/zara1/crowds_zara01.txt");
     if (ImGui::Button("browse...##trajectory")) {
       browser_.open("Trajectory file", browse_start(replay_path_, "trajectories"),

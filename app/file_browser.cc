@@ -7,6 +7,8 @@
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
+#include "common/ascii.h"
+
 namespace gk::app {
 namespace fs = std::filesystem;
 
@@ -59,10 +61,7 @@ void FileBrowser::enter(const fs::path& folder) {
       entries_.push_back({name, "[folder] " + name, true});
       continue;
     }
-    std::string ext = e.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
-      return static_cast<char>(std::tolower(c));
-    });
+    const std::string ext = lower_ascii(e.path().extension().string());
     if (extensions_.empty() ||
         std::find(extensions_.begin(), extensions_.end(), ext) != extensions_.end()) {
       entries_.push_back({name, name, false});

@@ -8,6 +8,7 @@
 #include <limits>
 #include <tuple>
 
+#include "common/ascii.h"
 #include "common/file_io.h"
 #include "common/text_snippet.h"
 
@@ -40,13 +41,16 @@ std::string_view trim(std::string_view t) {
 // or semicolon each (CSV: two separators in a row leave an empty field, reported as such).
 enum class Separator : uint8_t { kBlank, kComma, kSemicolon };
 
+// True for a row of text: printable ASCII and blanks only (not a binary file's bytes).
+bool is_text(std::string_view row) {
+  return std::all_of(row.begin(), row.end(),
+                     [](char ch) { return (ch >= 0x20 && ch < 0x7F) || is_space(ch); });
+}
+
 // Judged on the file's first row: a comma or semicolon in a row of text makes the file CSV (a
-// row that is not text, such as a binary file's bytes, is split on blanks and fails as data).
+// row that is not text is split on blanks and fails as data).
 Separator separator_of(std::string_view first_row) {
-  if (!std::all_of(first_row.begin(), first_row.end(),
-                   [](char ch) { return (ch >= 0x20 && ch < 0x7F) || is_space(ch); })) {
-    return Separator::kBlank;
-  }
+  if (!is_text(first_row)) return Separator::kBlank;
   if (first_row.find(',') != std::string_view::npos) return Separator::kComma;
   if (first_row.find(';') != std::string_view::npos) return Separator::kSemicolon;
   return Separator::kBlank;
@@ -89,7 +93,7 @@ Status parse_number(std::string_view token, const std::string& column, const std
                     int line, double* out_value) {
   double value = 0.0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (ec != std::errc() || end != token.data() + token.size() || token.empty()) {
+  if (ec != std::errc() || end != token.data() + token.size()) {
     return Status::AtLine(file, line, column + ": expected a number, found " + quoted_snippet(token));
   }
   if (!std::isfinite(value)) {
@@ -130,9 +134,9 @@ std::string normalised_name(std::string_view t) {
   std::string n;
   for (char c : t) {
     if (c == '"' || c == '\'' || c == '_' || c == '-' || c == '.' || is_space(c)) continue;
-    n.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+    n.push_back(c);
   }
-  return n;
+  return lower_ascii(n);
 }
 
 // Which of frame (0), id (1), x (2), y (3) or time (4) a header name stands for; -1 for none.
@@ -211,11 +215,9 @@ Status parse_row(std::string_view text_row, const std::string& file, int line, L
     double v = 0.0;
     const std::string_view t0 = count > 0 ? tokens[0] : std::string_view();
     const auto [end, ec] = std::from_chars(t0.data(), t0.data() + t0.size(), v);
-    // A header is text: printable ASCII with a letter in its first name (anything else, such
-    // as a binary file's bytes, is a data row that fails as one).
-    const bool text = std::all_of(text_row.begin(), text_row.end(),
-                                  [](char ch) { return ch >= 0x20 && ch < 0x7F; }) &&
-                      std::any_of(t0.begin(), t0.end(), [](char ch) {
+    // A header is text with a letter in its first name (anything else, such as a binary file's
+    // bytes, is a data row that fails as one).
+    const bool text = is_text(text_row) && std::any_of(t0.begin(), t0.end(), [](char ch) {
                         return std::isalpha(static_cast<unsigned char>(ch)) != 0;
                       });
     if (text && (ec != std::errc() || end != t0.data() + t0.size())) {

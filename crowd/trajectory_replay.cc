@@ -1,15 +1,15 @@
 #include "crowd/trajectory_replay.h"
 
-
 #include <algorithm>
-#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <numeric>
 #include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
 
+#include "common/ascii.h"
 #include "common/stats.h"
 #include "crowd/trajectory_file.h"
 
@@ -296,10 +296,6 @@ void TrajectoryReplay::update_live(float dt_s) {
   }
 }
 
-}  // namespace
-
-namespace {
-
 // Pedestrians walk at about 1.3 m/s. A file whose pedestrians would move implausibly fast or slow
 // in metres but at walking pace in centimetres or millimetres (trackers and lab datasets write
 // both) is in those units: the scale [m per file unit] and its name, or 1 for metres. Judged on
@@ -334,13 +330,8 @@ std::pair<double, const char*> detect_position_unit(const TrajectoryTable& t,
 }  // namespace
 
 bool is_trajectory_file_name(std::string_view path) {
-  const size_t dot = path.rfind('.');
-  if (dot == std::string_view::npos || path.find('/', dot) != std::string_view::npos) return false;
-  std::string ext;
-  for (char ch : path.substr(dot + 1)) {
-    ext.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(ch))));
-  }
-  return ext == "txt" || ext == "csv" || ext == "tsv" || ext == "dat";
+  const std::string ext = lower_ascii(std::filesystem::path(path).extension().string());
+  return ext == ".txt" || ext == ".csv" || ext == ".tsv" || ext == ".dat";
 }
 
 Result<std::unique_ptr<CrowdSource>> load_trajectory_replay(

@@ -3,8 +3,8 @@
 // tab or space separated; or the ETH authors' obsmat.txt, frame id pos_x pos_z pos_y v_x v_z v_y,
 // whose ground plane is (pos_x, pos_y)), or as CSV (comma or semicolon separated), with or without
 // a header row that names the frame (or time, in seconds), id, x and y columns (in any order,
-// among others); lines beginning with '#' are comments. Positions are resampled smoothly (C1: no velocity jumps) to the
-// simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
+// among others); lines beginning with '#' are comments. Positions are resampled smoothly (C1: no
+// velocity jumps) to the simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
 // is ignored: the data is the truth.
 //
 // Units: metres, unless the pedestrians would then move implausibly (their typical speed outside
@@ -21,8 +21,9 @@
 // (exact at the recorded times, no overshoot per axis), velocity is its derivative and theta is the
 // smoothed heading of the velocity, held while the speed is below 0.1 m/s.
 //
-// Errors (file and line): a header without frame, id, x or y, wrong column count, non-numbers, NaN/inf, frame not a whole number in
-// [0, 2^31), id not a whole number in [0, 2^32), duplicate (frame, id), no rows at all.
+// Errors (file and line): a header without frame (or time), id, x or y, wrong column count,
+// non-numbers, NaN/inf, frame not a whole number in [0, 2^31), time beyond +-1e7 s, id not a whole
+// number in [0, 2^32), duplicate (frame, id), no rows at all.
 //
 // With ReplayOptions::loop the file plays round and round for as long as it is stepped.
 

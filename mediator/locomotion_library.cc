@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -13,6 +12,7 @@
 #include "animation/mirror.h"
 #include "animation/pose_jobs.h"
 #include "animation/segmentation.h"
+#include "common/ascii.h"
 #include "common/stats.h"
 #include "mediator/springs.h"
 
@@ -34,13 +34,8 @@ constexpr std::array<const char*, 24> kNonLocomotion = {
     "punch",    "kick", "roll", "fall",  "hit",   "pistol", "sword", "spell",
     "interact", "push", "pick", "dance", "tpose", "t-pose", "driv",  "ride"};
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 bool name_excluded(const std::string& name) {
-  const std::string n = lower(name);
+  const std::string n = lower_ascii(name);
   for (const char* k : kNonLocomotion) {
     if (n.find(k) != std::string::npos) return true;
   }
@@ -1267,7 +1262,7 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
     // A clip named idle first (the plainest name: "Idle_Loop" before "Idle_Talking_Loop"), then
     // the calmest feet.
     auto rank = [](const LocomotionClip& c) {
-      return std::make_tuple(lower(c.clip.name).find("idle") == std::string::npos ? 1 : 0,
+      return std::make_tuple(lower_ascii(c.clip.name).find("idle") == std::string::npos ? 1 : 0,
                              c.clip.name.size(), c.analysis.floor.mean_cm_s);
     };
     auto calm = std::min_element(idles.begin(), idles.end(),
