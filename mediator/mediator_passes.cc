@@ -43,7 +43,7 @@ void for_each_agent(const PassCrowd& c, Fn&& fn) {
 // alone. (Weighting by x alone kept the slowest clip's cadence at any speed and folded all of the
 // slowing into the standing blend, which also flattens the swing.)
 void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, float speed,
-                       float share, float min_rate, std::span<float> w) {
+                       float share, float min_rate, float max_rate, std::span<float> w) {
   if (share <= 0.0f) return;
   const std::vector<int>& c = g.clips;
   const float first = lib.clips[c.front()].speed_m_s;
@@ -57,13 +57,32 @@ void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, fl
   for (size_t k = 0; k + 1 < c.size(); ++k) {
     const float a = lib.clips[c[k]].speed_m_s, b = lib.clips[c[k + 1]].speed_m_s;
     if (speed <= b) {
+      const bool walk_to_run =
+          lib.clips[c[k]].double_support && !lib.clips[c[k + 1]].double_support;
+      // A person walks or runs, never both at once (GAIT.md): where the walk played faster and
+      // the run played slower both reach the walk-run transition speed, each plays alone on its
+      // side of it (the playback rate matches the speed), and the gait changes over a band of
+      // a tenth of that speed about it (within what both can play). A blend of the two would
+      // mix the walk's double support with the run's flight: feet that land at the walk's
+      // contact while the run's are still swinging forward, stopped dead or sliding.
+      const float walk_top = a * max_rate, run_bottom = b * min_rate;
+      if (walk_to_run && run_bottom < walk_top) {
+        const float centre = std::clamp(lib.walk_run_speed_m_s, run_bottom, walk_top);
+        const float half = 0.05f * centre;
+        const float lo = std::max(run_bottom, centre - half);
+        const float hi = std::min(walk_top, centre + half);
+        const float u = std::clamp((speed - lo) / std::max(hi - lo, 1e-6f), 0.0f, 1.0f);
+        w[c[k]] += share * (1.0f - u);
+        w[c[k + 1]] += share * u;
+        return;
+      }
       // Between a walk and a run the heavier clip's feet lead (its contacts win the vote, its
       // swing dominates): the run, with its flight phase, never outweighs the walk below the
       // walk-run transition speed. Where the clips' midpoint is below it, the run's weight
       // reaches one half there, not at the midpoint (a slow walk and a bouncy jog would
       // otherwise have a 1.9 m/s pedestrian float between strides).
       float even = 0.5f * (a + b);  // speed at which the two weigh the same
-      if (lib.clips[c[k]].double_support && !lib.clips[c[k + 1]].double_support) {
+      if (walk_to_run) {
         // No further than halfway from the midpoint to the run: the run's weight still rises
         // over a quarter of the bracket (a run clip slower than the transition speed would
         // otherwise take all the weight in a step at its own speed).
@@ -84,6 +103,7 @@ void add_group_weights(const LocomotionLibrary& lib, const DirectionGroup& g, fl
 void choose_clip_weights(const LocomotionLibrary& lib, const MediatorParams& params, float speed,
                          float rel_dir, std::span<float> w, float min_cadence) {
   const float min_rate = std::max(params.min_playback_rate, min_cadence);
+  const float max_rate = params.max_playback_rate;
   std::fill(w.begin(), w.end(), 0.0f);
   if (speed < params.stop_speed_m_s) {
     w[lib.idle] = 1.0f;
@@ -106,7 +126,7 @@ void choose_clip_weights(const LocomotionLibrary& lib, const MediatorParams& par
   }
   const std::vector<DirectionGroup>& groups = lib.groups;
   if (groups.size() == 1) {
-    add_group_weights(lib, groups[0], speed, 1.0f, min_rate, w);
+    add_group_weights(lib, groups[0], speed, 1.0f, min_rate, max_rate, w);
     return;
   }
   // The two groups whose directions bracket rel_dir (circularly), interpolated by angle.
@@ -123,8 +143,8 @@ void choose_clip_weights(const LocomotionLibrary& lib, const MediatorParams& par
   float off = wrap_pi(rel_dir - a);
   if (off < 0.0f) off += 2.0f * kPi;
   const float u = std::clamp(off / span, 0.0f, 1.0f);
-  add_group_weights(lib, groups[lo], speed, 1.0f - u, min_rate, w);
-  add_group_weights(lib, groups[hi], speed, u, min_rate, w);
+  add_group_weights(lib, groups[lo], speed, 1.0f - u, min_rate, max_rate, w);
+  add_group_weights(lib, groups[hi], speed, u, min_rate, max_rate, w);
 }
 
 void filter_pass(const PassCrowd& c, const AgentFrame& frame, std::span<const glm::vec2> root_xz,

@@ -295,6 +295,59 @@ TEST(Quality, RunnersFeetLandWithoutSnapping) {
   }
 }
 
+// A person walks or runs, never both at once (GAIT.md: the switch comes at about 2 m/s). The
+// subject-16 fast walk (1.73 m/s) played faster and its jog (2.86 m/s) played slower both reach
+// the walk-run speed: each plays alone on its side of it, and the gait changes over a band of a
+// tenth of that speed. Blended by speed across the whole bracket, a 2.4 m/s runner mixed the
+// walk's double support with the jog's flight: the blend planted a foot at the walk's contact
+// while the jog's was still swinging forward at 2-3 m/s, and the lock stopped it dead there.
+TEST(Quality, WalkersAndRunnersDoNotMixTheirGaits) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh");
+  auto lib = test::subject16_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const DirectionGroup& g = lib->groups[lib->forward_group];
+  int walk = -1, run = -1;  // the fastest walk and the slowest run
+  for (int c : g.clips) {
+    if (lib->clips[c].double_support) {
+      walk = c;
+    } else if (run < 0) {
+      run = c;
+    }
+  }
+  ASSERT_GE(walk, 0);
+  ASSERT_GE(run, 0);
+  const MediatorParams p;
+  const float v_walk = lib->clips[walk].speed_m_s, v_run = lib->clips[run].speed_m_s;
+  // The two can meet: the walk at its fastest rate outruns the run at its slowest.
+  ASSERT_LT(v_run * p.min_playback_rate, v_walk * p.max_playback_rate);
+  const float centre = std::clamp(lib->walk_run_speed_m_s, v_run * p.min_playback_rate,
+                                  v_walk * p.max_playback_rate);
+  std::vector<float> w(lib->clips.size());
+  float last_run = 0.0f;
+  for (float v = v_walk; v <= v_run; v += 0.01f) {
+    choose_clip_weights(*lib, p, v, 0.0f, w);
+    EXPECT_NEAR(w[walk] + w[run], 1.0f, 1e-5f) << v;
+    EXPECT_GE(w[run], last_run - 1e-6f) << v;  // the run's share only grows with the speed
+    last_run = w[run];
+    if (std::abs(v - centre) > 0.05f * centre + 1e-3f) {
+      EXPECT_EQ(std::min(w[walk], w[run]), 0.0f) << v;  // one gait alone
+      EXPECT_EQ(w[run] > 0.5f, v > centre) << v;
+    }
+  }
+  for (const float speed : {1.9f, 2.4f, 2.7f}) {
+    std::vector<test::Script> s;
+    for (int i = 0; i < 4; ++i) s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, speed}));
+    const auto apm = test::run_scripted(*lib, s, p, 1200);
+    EXPECT_LE(apm.report.feet.limb_pop_rate, 1.0) << speed;
+    EXPECT_LE(apm.report.feet.support_slide_cm_s, 2.0) << speed;
+    EXPECT_LE(apm.report.root_error_cm.mean, 3.0) << speed;
+    // (Before: 6.0 cm/s and a skate ratio of 0.086 at 2.4 m/s, the fast walk weighing 0.4.)
+    if (speed > centre) {
+      EXPECT_LE(apm.report.feet.support_skate_ratio, 0.005) << speed;
+    }
+  }
+}
+
 // How far a knee lies on the pelvis's forward side of its hip-ankle line in a pose's model or
 // world joints [m] (negative: behind, a knee bent backwards). Forward is across the hips, left
 // to right, turned a quarter about the vertical.
