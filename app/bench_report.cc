@@ -102,7 +102,8 @@ json to_json(const BenchReport& r) {
     const BenchReport::Transitions& t = *r.transitions;
     out["transitions"] = {{"starts", t.starts},           {"starts_played", t.starts_played},
                           {"stops", t.stops},             {"stops_played", t.stops_played},
-                          {"start_clips", t.start_clips}, {"stop_clips", t.stop_clips}};
+                          {"creep_stops", t.creep_stops}, {"start_clips", t.start_clips},
+                          {"stop_clips", t.stop_clips}};
   } else {
     out["transitions"] = nullptr;
   }
@@ -162,7 +163,8 @@ std::string summary(const BenchReport& r) {
     s += "  transitions (library: " + std::to_string(t.start_clips) + " start, " +
          std::to_string(t.stop_clips) + " stop clips): starts " + std::to_string(t.starts) +
          ", played " + std::to_string(t.starts_played) + "; stops " + std::to_string(t.stops) +
-         ", played " + std::to_string(t.stops_played) + "\n";
+         ", played " + std::to_string(t.stops_played) + "; rests from a creep (below 0.15 m/s) " +
+         std::to_string(t.creep_stops) + "\n";
   }
   if (r.metrics) {
     const nlohmann::json& m = *r.metrics;

@@ -118,6 +118,7 @@ struct BenchReport {
   // stop clip of the library (transitions; none without takes that have them).
   struct Transitions {
     int64_t starts = 0, starts_played = 0, stops = 0, stops_played = 0;
+    int64_t creep_stops = 0;  // agents that came to rest from a creep (not counted in stops)
     int64_t start_clips = 0, stop_clips = 0;  // in the library
   };
   std::optional<Transitions> transitions;

@@ -422,6 +422,7 @@ void run_bench(const BenchOptions& o) {
     t.starts_played = static_cast<int64_t>(counts[kStartsPlayed]);
     t.stops = static_cast<int64_t>(counts[kStopsSeen]);
     t.stops_played = static_cast<int64_t>(counts[kStopsPlayed]);
+    t.creep_stops = static_cast<int64_t>(counts[kCreepStops]);
     for (const Transition& tr : library.transitions) {
       ++(tr.kind == TransitionKind::kStart ? t.start_clips : t.stop_clips);
     }

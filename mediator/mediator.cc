@@ -80,7 +80,8 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   tr_index_.assign(capacity, -1);
   tr_stage_.assign(capacity, TransitionStage::kNone);
   for (auto* v : {&tr_time_, &tr_weight_, &tr_waited_, &tr_min_cadence_, &tr_chosen_speed_,
-                  &tr_lag_, &tr_prev_speed_, &tr_prev_phase_, &tr_still_, &tr_moving_}) {
+                  &tr_lag_, &tr_prev_speed_, &tr_prev_phase_, &tr_still_, &tr_moving_,
+                  &tr_peak_speed_}) {
     v->assign(capacity, 0.0f);
   }
   tr_rate_.assign(capacity, 1.0f);
@@ -284,7 +285,8 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                   pl.layer_weight, pl.gait_weight, pl.phase,
                   {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_,
                    tr_min_cadence_, tr_chosen_speed_, tr_lag_, tr_prev_speed_, tr_prev_phase_,
-                   tr_still_, tr_moving_, tr_start_due_, tr_counts_, reach_boost_});
+                   tr_still_, tr_moving_, tr_peak_speed_, tr_start_due_, tr_counts_,
+                   reach_boost_});
   contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, tr_time_,
                 pl.gait_weight, pl.playback_rate, tr_rate_, pl.layer_time_s,
                 {{pl.plant[0], pl.plant[1]},

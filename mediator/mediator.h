@@ -139,7 +139,7 @@ class Mediator {
   std::vector<TransitionStage> tr_stage_;
   std::vector<float> tr_time_, tr_weight_, tr_rate_, tr_waited_, tr_min_cadence_, tr_chosen_speed_,
       tr_lag_, tr_prev_speed_, tr_prev_phase_;
-  std::vector<float> tr_still_, tr_moving_;
+  std::vector<float> tr_still_, tr_moving_, tr_peak_speed_;
   std::vector<uint8_t> tr_start_due_;
   std::vector<uint32_t> tr_counts_;  // [slot * kNumCounts + k]
   // Per slot, scratch between passes.

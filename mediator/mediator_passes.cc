@@ -602,6 +602,7 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
       st.min_cadence[slot] = 0.0f;
       st.rate[slot] = 1.0f;
       st.still_s[slot] = st.moving_s[slot] = 0.0f;
+      st.peak_speed_m_s[slot] = 0.0f;
       st.start_due[slot] = 0;
       st.prev_speed_m_s[slot] = v;
       st.prev_phase[slot] = phase[slot];
@@ -611,13 +612,18 @@ void transition_pass(const PassCrowd& c, std::span<const float> speed_m_s,
     const float prev_phase = st.prev_phase[slot];
     st.prev_speed_m_s[slot] = v;
     const bool start_seen = !stand && st.still_s[slot] >= kTransitionSettle;
-    const bool stop_seen = stand && st.moving_s[slot] >= kTransitionSettle;
+    const bool came_to_rest = stand && st.moving_s[slot] >= kTransitionSettle;
+    // A stop from a walk: a creep (never as fast as a take's standing speed) has no step to stop.
+    const bool stop_seen = came_to_rest && st.peak_speed_m_s[slot] >= kStill;
+    if (came_to_rest && !stop_seen) ++counts[kCreepStops];
     if (stand) {
       st.still_s[slot] += dt;
       st.moving_s[slot] = 0.0f;
+      st.peak_speed_m_s[slot] = 0.0f;
     } else {
       st.moving_s[slot] += dt;
       st.still_s[slot] = 0.0f;
+      st.peak_speed_m_s[slot] = std::max(st.peak_speed_m_s[slot], v);
     }
     TransitionStage& stage = st.stage[slot];
     int16_t& index = st.index[slot];

@@ -254,8 +254,18 @@ enum class TransitionStage : uint8_t {
   kPlaying,  // fading in or at full weight
   kLeaving,  // fading out: a start handing over to the cycle, a stop at rest, or an abort
 };
-// What transition_counts() sums: starts and stops seen and how many played a transition clip.
-enum TransitionCount : int { kStartsSeen, kStartsPlayed, kStopsSeen, kStopsPlayed, kNumCounts };
+// What transition_counts() sums: starts and stops seen and how many played a transition clip,
+// and the creeping agents' stops, not counted as stops: an agent that came to rest without
+// having moved as fast as a take's standing speed since it last stood (0.15 m/s, segmentation's
+// idle speed: slower than any moving frame of a stop clip, which has no step to play for it).
+enum TransitionCount : int {
+  kStartsSeen,
+  kStartsPlayed,
+  kStopsSeen,
+  kStopsPlayed,
+  kCreepStops,
+  kNumCounts
+};
 struct TransitionState {
   std::span<int16_t> index;  // into library.transitions, -1: none
   std::span<TransitionStage> stage;
@@ -272,6 +282,7 @@ struct TransitionState {
   std::span<float> lag_m;  // playing: the agent's distance travelled minus the clip's [m]
   std::span<float> prev_speed_m_s, prev_phase;
   std::span<float> still_s, moving_s;  // how long the agent has stood / moved [s]
+  std::span<float> peak_speed_m_s;     // the fastest it has moved since it last stood [m/s]
   // 1: a start seen while a stop still played (the agent set off again as it faded out), to
   // begin once the stop has gone.
   std::span<uint8_t> start_due;

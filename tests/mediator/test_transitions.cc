@@ -254,12 +254,12 @@ TEST(Transitions, AChosenStopIsKeptThroughASpeedBumpBelowTheSpeedItWasChosenAt) 
   std::vector<int16_t> index{-1};
   std::vector<TransitionStage> stage{TransitionStage::kNone};
   std::vector<float> time{0}, weight{0}, tr_rate{1}, waited{0}, min_cadence{0}, chosen{0}, lag{0},
-      prev_speed{0}, prev_phase{0}, still{0}, moving{0};
+      prev_speed{0}, prev_phase{0}, still{0}, moving{0}, peak{0};
   std::vector<uint8_t> start_due{0};
   std::vector<uint32_t> counts(kNumCounts, 0);
   const TransitionState state{index,      stage,      time,  weight, tr_rate,   waited,
                               min_cadence, chosen,    lag,   prev_speed, prev_phase, still,
-                              moving,     start_due, counts};
+                              moving,     peak,       start_due, counts};
   // The gait phase stands still: the stop's own phase never comes, so it waits.
   auto step = [&](float v) {
     speed[0] = v;
@@ -276,6 +276,54 @@ TEST(Transitions, AChosenStopIsKeptThroughASpeedBumpBelowTheSpeedItWasChosenAt) 
   EXPECT_EQ(stage[0], TransitionStage::kWaiting) << "given up for a frame's rise of the speed";
   step(v = chosen_at + 0.05f);  // walking on, faster than it was
   EXPECT_EQ(stage[0], TransitionStage::kNone) << "kept though the agent walks on";
+}
+
+// A stop is an agent coming to rest from a walk. One that only crept (never as fast as a take's
+// standing speed, 0.15 m/s, below every moving frame of a stop clip) has no step to stop: its rest
+// is counted apart, as a creep's, and is not a stop seen and missed.
+TEST(Transitions, ARestFromACreepIsNotAStop) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_33_slow_walk_stop_mrl30.bvh");
+  auto lib = start_stop_library();
+  ASSERT_TRUE(lib.ok()) << lib.message();
+  const MediatorParams params;
+  const float still = SegmentationThresholds{}.idle_speed_m_s;
+  ASSERT_LT(params.stop_speed_m_s, still);
+  for (const Transition& tr : lib->transitions) {
+    if (tr.kind != TransitionKind::kStop) continue;
+    EXPECT_GE(tr.speed_at(tr.moving_to_s - 0.5f / tr.fps), 0.9f * still);
+  }
+  const std::vector<int32_t> slot_of_agent{0};
+  std::vector<uint8_t> fresh{1}, standing{1};
+  const PassCrowd crowd{*lib, params, kDt, slot_of_agent, fresh};
+  std::vector<float> speed{0.0f}, rate{1.0f}, gait{1.0f}, phase{0.0f};
+  std::vector<int16_t> layer_clip(kMaxBlendLayers, static_cast<int16_t>(lib->idle));
+  std::vector<float> layer_weight(kMaxBlendLayers, 0.0f);
+  layer_weight[0] = 1.0f;
+  std::vector<int16_t> index{-1};
+  std::vector<TransitionStage> stage{TransitionStage::kNone};
+  std::vector<float> time{0}, weight{0}, tr_rate{1}, waited{0}, min_cadence{0}, chosen{0}, lag{0},
+      prev_speed{0}, prev_phase{0}, still_s{0}, moving{0}, peak{0};
+  std::vector<uint8_t> start_due{0};
+  std::vector<uint32_t> counts(kNumCounts, 0);
+  const TransitionState state{index,      stage,      time,    weight, tr_rate,   waited,
+                              min_cadence, chosen,    lag,     prev_speed, prev_phase, still_s,
+                              moving,     peak,       start_due, counts};
+  auto step = [&](float v) {
+    speed[0] = v;
+    standing[0] = v < params.stop_speed_m_s ? 1 : 0;
+    transition_pass(crowd, speed, rate, standing, layer_clip, layer_weight, gait, phase, state);
+    fresh[0] = 0;
+  };
+  for (int f = 0; f < 30; ++f) step(0.0f);
+  for (int f = 0; f < 60; ++f) step(0.9f * still);  // a creep, 1 s
+  for (int f = 0; f < 30; ++f) step(0.0f);
+  EXPECT_EQ(counts[kStopsSeen], 0u);
+  EXPECT_EQ(counts[kCreepStops], 1u);
+  for (int f = 0; f < 60; ++f) step(f < 30 ? 1.1f * still : 0.9f * still);  // faster, then slower
+  for (int f = 0; f < 30; ++f) step(0.0f);
+  EXPECT_EQ(counts[kStopsSeen], 1u);
+  EXPECT_EQ(counts[kCreepStops], 1u);
+  EXPECT_EQ(counts[kStartsSeen], 2u);
 }
 
 TEST(Transitions, TheBuiltinLibraryHasNone) {
