@@ -65,6 +65,7 @@ json to_json(const BenchReport& r) {
       {"takes", r.takes},
       {"left_out", r.left_out},
       {"doubtful_clips", r.doubtful},
+      {"library_gaps", r.gaps},
       {"timing_ms", timing},
       {"us_per_agent", or_null(r.us_per_agent)},
       {"metrics", r.metrics ? *r.metrics : json(nullptr)},
@@ -176,6 +177,7 @@ std::string summary(const BenchReport& r) {
     for (const std::string& t : r.takes) s += "\n  take " + t;
     for (const std::string& l : r.left_out) s += "\n  left out: " + l;
     for (const std::string& d : r.doubtful) s += "\n  doubtful: " + d;
+    for (const std::string& g : r.gaps) s += "\n  library gap: " + g;
     s += "\n  foot slide " + num(m["foot_slide_cm_s"], 2) + " cm/s (p95 " +
          num(m["foot_slide_p95_cm_s"], 2) + ", clips' floor " + num(m["foot_slide_floor_cm_s"], 2) +
          "), skate ratio " + num(m["skate_ratio"], 4) + ", drift " +

@@ -108,6 +108,8 @@ struct BenchReport {
   // Gait clips whose contact analysis is doubtful, and why: "clip: why; ...; played without foot
   // locks".
   std::vector<std::string> doubtful;
+  // What the library's forward clips cannot play (describe_gaps): "no walking clip ...".
+  std::vector<std::string> gaps;
   std::array<std::optional<TimingStat>, kNumStages> timing_ms;
   std::optional<double> us_per_agent;     // median total / agents * 1000
   std::optional<nlohmann::json> metrics;  // METRICS.md metrics, once the mediator exists

@@ -270,6 +270,16 @@ void DemoApp::panel_clips() {
     for (const std::string& d : doubtful) ImGui::TextDisabled("%s", d.c_str());
     ImGui::PopTextWrapPos();
   }
+  // What the clips cannot play (no walk; a walk and a run too far apart in speed).
+  const MediatorParams& mp = session_->params();
+  const std::vector<std::string> gaps =
+      describe_gaps(session_->library(), mp.min_playback_rate, mp.max_playback_rate);
+  if (!gaps.empty()) {
+    ImGui::Text("library gaps:");
+    ImGui::PushTextWrapPos(0.0f);
+    for (const std::string& g : gaps) ImGui::TextDisabled("%s", g.c_str());
+    ImGui::PopTextWrapPos();
+  }
 }
 
 void DemoApp::panel_view() {

@@ -835,6 +835,51 @@ std::vector<std::string> describe_doubts(const LocomotionLibrary& library) {
   return lines;
 }
 
+std::vector<std::string> describe_gaps(const LocomotionLibrary& library, float min_playback_rate,
+                                       float max_playback_rate) {
+  std::vector<std::string> lines;
+  if (library.forward_group < 0 ||
+      library.forward_group >= static_cast<int>(library.groups.size())) {
+    return lines;
+  }
+  int walk = -1, run = -1;  // the fastest walk and the slowest run, by speed
+  for (int c : library.groups[library.forward_group].clips) {
+    const LocomotionClip& clip = library.clips[c];
+    if (!clip.gait) continue;
+    if (clip.double_support) {
+      walk = c;
+    } else if (run < 0) {
+      run = c;
+    }
+  }
+  char buf[512];
+  if (walk < 0 && run >= 0) {
+    const LocomotionClip& r = library.clips[run];
+    std::snprintf(buf, sizeof(buf),
+                  "no walking clip (every forward gait clip has a flight phase): agents slower "
+                  "than %.2f m/s (%s, %.2f m/s, at the slowest playback rate, %.2fx) are shown "
+                  "running slowly, blended with standing below that; a run's flight and push-off "
+                  "at walking speeds float and slide (METRICS.md float_ratio, support slide)",
+                  r.speed_m_s * min_playback_rate, r.clip.name.c_str(), r.speed_m_s,
+                  min_playback_rate);
+    lines.emplace_back(buf);
+  } else if (walk >= 0 && run >= 0) {
+    const LocomotionClip& w = library.clips[walk];
+    const LocomotionClip& r = library.clips[run];
+    const float top = w.speed_m_s * max_playback_rate, bottom = r.speed_m_s * min_playback_rate;
+    if (top < bottom) {
+      std::snprintf(buf, sizeof(buf),
+                    "no clip plays alone between %.2f m/s (%s, %.2f m/s, at the fastest playback "
+                    "rate, %.2fx) and %.2f m/s (%s, %.2f m/s, at the slowest, %.2fx): a walk and "
+                    "a run are blended there, the walk's double support with the run's flight",
+                    top, w.clip.name.c_str(), w.speed_m_s, max_playback_rate, bottom,
+                    r.clip.name.c_str(), r.speed_m_s, min_playback_rate);
+      lines.emplace_back(buf);
+    }
+  }
+  return lines;
+}
+
 bool gait_analysis_doubtful(const LocomotionLibrary& library) {
   int gait = 0;
   for (const LocomotionClip& c : library.clips) {

@@ -204,6 +204,14 @@ std::vector<std::string> describe_left_out(const LocomotionLibrary& library);
 // every gait clip is, a last line says the library is played as the naive mode plays it.
 std::vector<std::string> describe_doubts(const LocomotionLibrary& library);
 
+// What the library's forward clips cannot play, one line each, for a user to be told rather than
+// find out: no walking clip (every forward gait clip has a flight phase: walkers are shown
+// running slowly), or a walk and a run too far apart in speed for either to play alone in
+// between at the playback rate limits (a walk's double support blended with a run's flight).
+// Empty when neither.
+std::vector<std::string> describe_gaps(const LocomotionLibrary& library, float min_playback_rate,
+                                       float max_playback_rate);
+
 // True when the library has gait clips and the contact analysis of every one is doubtful: nothing
 // the mediator adds (foot locks, rate and phase matching, blends aligned on contacts) can be
 // trusted with it, so apm plays it as naive does and is never worse than naive.

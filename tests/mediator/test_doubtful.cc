@@ -2,6 +2,8 @@
 // doubtful, played without foot locks, and the mediator with it is never worse than the naive
 // player on the METRICS.md figures.
 
+#include <algorithm>
+#include <cstdio>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -201,6 +203,46 @@ TEST(DoubtfulClips, ALibraryWithOneSoundGaitClipKeepsTheMediator) {
   Mediator d(*hop_lib, p, 4);
   EXPECT_TRUE(d.degraded());
   EXPECT_EQ(d.params().mode, MediatorMode::kNaive);
+}
+
+// What the clips cannot play is said: a run alone has no walk for walkers, and a walk and a run
+// too far apart in speed (the fastest walk at the fastest rate slower than the slowest run at the
+// slowest) leave a band where only a blend of the two plays. Libraries that can play every speed
+// (the built-in set, subject 16's with its fast walk and jog) say nothing.
+TEST(DoubtfulClips, WhatALibraryCannotPlayIsSaid) {
+  const MediatorParams p;
+  EXPECT_TRUE(describe_gaps(test::builtin_library(), p.min_playback_rate, p.max_playback_rate)
+                  .empty());
+  GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh");
+  auto run = test::load_data_library({"clips/bvh/cmu_09_11_run.bvh"});
+  ASSERT_TRUE(run.ok()) << run.message();
+  const auto run_gaps = describe_gaps(*run, p.min_playback_rate, p.max_playback_rate);
+  ASSERT_EQ(run_gaps.size(), 1u);
+  EXPECT_EQ(run_gaps[0].rfind("no walking clip", 0), 0u) << run_gaps[0];
+  auto pair =
+      test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
+  ASSERT_TRUE(pair.ok()) << pair.message();
+  const auto pair_gaps = describe_gaps(*pair, p.min_playback_rate, p.max_playback_rate);
+  ASSERT_EQ(pair_gaps.size(), 1u);
+  EXPECT_EQ(pair_gaps[0].rfind("no clip plays alone between", 0), 0u) << pair_gaps[0];
+  // The band's ends: the walk at the fastest rate, the run at the slowest.
+  float walk = 0.0f, slowest_run = 1e9f;
+  for (const LocomotionClip& c : pair->clips) {
+    if (!c.gait) continue;
+    if (c.double_support) walk = std::max(walk, c.speed_m_s);
+    if (!c.double_support) slowest_run = std::min(slowest_run, c.speed_m_s);
+  }
+  char band[64];
+  std::snprintf(band, sizeof(band), "between %.2f m/s", walk * p.max_playback_rate);
+  EXPECT_NE(pair_gaps[0].find(band), std::string::npos) << pair_gaps[0];
+  std::snprintf(band, sizeof(band), "and %.2f m/s", slowest_run * p.min_playback_rate);
+  EXPECT_NE(pair_gaps[0].find(band), std::string::npos) << pair_gaps[0];
+  // Played faster, the walk reaches the run: no band.
+  EXPECT_TRUE(describe_gaps(*pair, p.min_playback_rate, 2.0f).empty());
+  auto s16 = test::subject16_library();
+  ASSERT_TRUE(s16.ok()) << s16.message();
+  EXPECT_TRUE(describe_gaps(*s16, p.min_playback_rate, p.max_playback_rate).empty());
 }
 
 }  // namespace
