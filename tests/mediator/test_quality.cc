@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -227,6 +228,26 @@ TEST(Quality, ReplayedPedestriansWithTheMannequinClips) {
   EXPECT_FALSE(apm.feedback_speed_change.has_value());  // replay ignores feedback: none is asked
 }
 
+// n agents abreast, 2 m apart, going straight ahead at `speed` [m/s].
+std::vector<test::Script> abreast(int n, float speed) {
+  std::vector<test::Script> s;
+  for (int i = 0; i < n; ++i) s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, speed}));
+  return s;
+}
+
+// The fastest walk and the slowest run among a library's forward clips (-1: none).
+std::pair<int, int> fastest_walk_and_slowest_run(const LocomotionLibrary& lib) {
+  int walk = -1, run = -1;
+  for (int c : lib.groups[lib.forward_group].clips) {
+    if (lib.clips[c].double_support) {
+      walk = c;
+    } else if (run < 0) {
+      run = c;
+    }
+  }
+  return {walk, run};
+}
+
 // Pedestrians of 1.6 to 2.0 m/s walk (GAIT.md: people switch to running at about 2 m/s). The
 // mannequin's walk (1.05 m/s) and jog (2.58 m/s, stance under a fifth of its cycle, the toes
 // swung 35 cm high) meet at 1.82 m/s; blended by speed alone the jog outweighed the walk from
@@ -238,15 +259,7 @@ TEST(Quality, MannequinPedestriansBelowTheWalkRunSpeedWalk) {
   // Froude number 0.5 at the skeleton's hip height: the hips of a flat-footed mannequin stand
   // about 0.9 m high, so about 2.1 m/s.
   EXPECT_NEAR(lib->walk_run_speed_m_s, std::sqrt(0.5f * 9.81f * 0.9f), 0.1f);
-  const DirectionGroup& g = lib->groups[lib->forward_group];
-  int walk = -1, run = -1;  // the fastest walk and the slowest run (two walks, jog, sprint)
-  for (int c : g.clips) {
-    if (lib->clips[c].double_support) {
-      walk = c;
-    } else if (run < 0) {
-      run = c;
-    }
-  }
+  const auto [walk, run] = fastest_walk_and_slowest_run(*lib);  // two walks, jog, sprint
   ASSERT_GE(walk, 0);
   ASSERT_GE(run, 0);
   const MediatorParams p;
@@ -256,9 +269,7 @@ TEST(Quality, MannequinPedestriansBelowTheWalkRunSpeedWalk) {
     EXPECT_GE(w[walk], w[run]) << v;
   }
   for (const float speed : {1.6f, 1.8f, 2.0f}) {
-    std::vector<test::Script> s;
-    for (int i = 0; i < 6; ++i) s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, speed}));
-    const auto apm = test::run_scripted(*lib, s, p, 1200);
+    const auto apm = test::run_scripted(*lib, abreast(6, speed), p, 1200);
     // (0.54 at 2.0 m/s with the jog the heavier; what floats now is each agent's first steps)
     EXPECT_LE(apm.report.feet.float_ratio, 0.01) << speed;
     EXPECT_LE(apm.report.feet.support_slide_cm_s, 2.0) << speed;
@@ -287,9 +298,7 @@ TEST(Quality, RunnersFeetLandWithoutSnapping) {
   EXPECT_NEAR(lib->max_rest_speed_m_s, 0.5f * std::sqrt(0.5f * 9.81f * leg), 1e-3f);
   EXPECT_LT(lib->max_rest_speed_m_s, 0.5f * lib->max_speed_m_s);  // tighter than a run's "still"
   for (const float speed : {3.0f, 3.5f}) {
-    std::vector<test::Script> s;
-    for (int i = 0; i < 4; ++i) s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, speed}));
-    const auto apm = test::run_scripted(*lib, s, MediatorParams{}, 1200);
+    const auto apm = test::run_scripted(*lib, abreast(4, speed), MediatorParams{}, 1200);
     EXPECT_LE(apm.report.feet.limb_pop_rate, 1.0) << speed;
     EXPECT_LE(apm.report.feet.penetration_max_cm, 1.5) << speed;
   }
@@ -305,15 +314,7 @@ TEST(Quality, WalkersAndRunnersDoNotMixTheirGaits) {
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh");
   auto lib = test::subject16_library();
   ASSERT_TRUE(lib.ok()) << lib.message();
-  const DirectionGroup& g = lib->groups[lib->forward_group];
-  int walk = -1, run = -1;  // the fastest walk and the slowest run
-  for (int c : g.clips) {
-    if (lib->clips[c].double_support) {
-      walk = c;
-    } else if (run < 0) {
-      run = c;
-    }
-  }
+  const auto [walk, run] = fastest_walk_and_slowest_run(*lib);
   ASSERT_GE(walk, 0);
   ASSERT_GE(run, 0);
   const MediatorParams p;
@@ -335,9 +336,7 @@ TEST(Quality, WalkersAndRunnersDoNotMixTheirGaits) {
     }
   }
   for (const float speed : {1.9f, 2.4f, 2.7f}) {
-    std::vector<test::Script> s;
-    for (int i = 0; i < 4; ++i) s.push_back(test::straight({2.0f * i, 0.0f}, {0.0f, speed}));
-    const auto apm = test::run_scripted(*lib, s, p, 1200);
+    const auto apm = test::run_scripted(*lib, abreast(4, speed), p, 1200);
     EXPECT_LE(apm.report.feet.limb_pop_rate, 1.0) << speed;
     EXPECT_LE(apm.report.feet.support_slide_cm_s, 2.0) << speed;
     EXPECT_LE(apm.report.root_error_cm.mean, 3.0) << speed;

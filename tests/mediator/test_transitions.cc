@@ -235,6 +235,43 @@ TEST(Transitions, TheCycleStepsWithTheTransitionsFeet) {
   EXPECT_GE(landings, 10);
 }
 
+// One agent's transition pass, run frame by frame on its own: its inputs (one layer at full
+// weight) and the state the pass keeps.
+struct OneAgentTransitions {
+  OneAgentTransitions(const LocomotionLibrary& lib, const MediatorParams& params, int16_t clip,
+                      float speed_m_s, bool stands)
+      : crowd{lib, params, kDt, slot_of_agent, fresh},
+        speed{speed_m_s},
+        standing{static_cast<uint8_t>(stands ? 1 : 0)},
+        layer_clip(kMaxBlendLayers, static_cast<int16_t>(lib.idle)),
+        layer_weight(kMaxBlendLayers, 0.0f) {
+    layer_clip[0] = clip;
+    layer_weight[0] = 1.0f;
+  }
+  // One frame at speed v (standing as set).
+  void step(float v) {
+    speed[0] = v;
+    transition_pass(crowd, speed, rate, standing, layer_clip, layer_weight, gait, phase, state);
+    fresh[0] = 0;
+  }
+  const std::vector<int32_t> slot_of_agent{0};
+  std::vector<uint8_t> fresh{1};
+  const PassCrowd crowd;
+  std::vector<float> speed, rate{1.0f}, gait{1.0f}, phase{0.0f};
+  std::vector<uint8_t> standing;
+  std::vector<int16_t> layer_clip;
+  std::vector<float> layer_weight;
+  std::vector<int16_t> index{-1};
+  std::vector<TransitionStage> stage{TransitionStage::kNone};
+  std::vector<float> time{0}, weight{0}, tr_rate{1}, waited{0}, min_cadence{0}, chosen{0}, lag{0},
+      prev_speed{0}, prev_phase{0}, still{0}, moving{0}, peak{0};
+  std::vector<uint8_t> start_due{0};
+  std::vector<uint32_t> counts = std::vector<uint32_t>(kNumCounts, 0);
+  const TransitionState state{index,       stage,  time, weight,     tr_rate,    waited,
+                              min_cadence, chosen, lag,  prev_speed, prev_phase, still,
+                              moving,      peak,   start_due, counts};
+};
+
 // A stop once chosen waits for the gait phase its first step matches. A speed that rises for a
 // frame while the agent slows down (a DetourCrowd agent's in a jam does so all the time) is not
 // walking on: the stop is given up only once the agent is faster than when it was chosen.
@@ -243,29 +280,11 @@ TEST(Transitions, AChosenStopIsKeptThroughASpeedBumpBelowTheSpeedItWasChosenAt) 
   auto lib = start_stop_library();
   ASSERT_TRUE(lib.ok()) << lib.message();
   const MediatorParams params;
-  const std::vector<int32_t> slot_of_agent{0};
-  std::vector<uint8_t> fresh{1}, standing{0};
-  const PassCrowd crowd{*lib, params, kDt, slot_of_agent, fresh};
-  std::vector<float> speed{1.1f}, rate{1.0f}, gait{1.0f}, phase{0.0f};
-  std::vector<int16_t> layer_clip(kMaxBlendLayers, static_cast<int16_t>(lib->idle));
-  std::vector<float> layer_weight(kMaxBlendLayers, 0.0f);
-  layer_clip[0] = static_cast<int16_t>(lib->transitions.front().cycle_clip);
-  layer_weight[0] = 1.0f;
-  std::vector<int16_t> index{-1};
-  std::vector<TransitionStage> stage{TransitionStage::kNone};
-  std::vector<float> time{0}, weight{0}, tr_rate{1}, waited{0}, min_cadence{0}, chosen{0}, lag{0},
-      prev_speed{0}, prev_phase{0}, still{0}, moving{0}, peak{0};
-  std::vector<uint8_t> start_due{0};
-  std::vector<uint32_t> counts(kNumCounts, 0);
-  const TransitionState state{index,      stage,      time,  weight, tr_rate,   waited,
-                              min_cadence, chosen,    lag,   prev_speed, prev_phase, still,
-                              moving,     peak,       start_due, counts};
   // The gait phase stands still: the stop's own phase never comes, so it waits.
-  auto step = [&](float v) {
-    speed[0] = v;
-    transition_pass(crowd, speed, rate, standing, layer_clip, layer_weight, gait, phase, state);
-    fresh[0] = 0;
-  };
+  OneAgentTransitions t(*lib, params, static_cast<int16_t>(lib->transitions.front().cycle_clip),
+                        1.1f, false);
+  auto step = [&](float v) { t.step(v); };
+  const std::vector<TransitionStage>& stage = t.stage;
   float v = 1.1f;
   for (int f = 0; f < 30; ++f) step(v);  // walking
   for (int f = 0; f < 60 && stage[0] != TransitionStage::kWaiting; ++f) step(v -= 1.0f * kDt);
@@ -292,28 +311,12 @@ TEST(Transitions, ARestFromACreepIsNotAStop) {
     if (tr.kind != TransitionKind::kStop) continue;
     EXPECT_GE(tr.speed_at(tr.moving_to_s - 0.5f / tr.fps), 0.9f * still);
   }
-  const std::vector<int32_t> slot_of_agent{0};
-  std::vector<uint8_t> fresh{1}, standing{1};
-  const PassCrowd crowd{*lib, params, kDt, slot_of_agent, fresh};
-  std::vector<float> speed{0.0f}, rate{1.0f}, gait{1.0f}, phase{0.0f};
-  std::vector<int16_t> layer_clip(kMaxBlendLayers, static_cast<int16_t>(lib->idle));
-  std::vector<float> layer_weight(kMaxBlendLayers, 0.0f);
-  layer_weight[0] = 1.0f;
-  std::vector<int16_t> index{-1};
-  std::vector<TransitionStage> stage{TransitionStage::kNone};
-  std::vector<float> time{0}, weight{0}, tr_rate{1}, waited{0}, min_cadence{0}, chosen{0}, lag{0},
-      prev_speed{0}, prev_phase{0}, still_s{0}, moving{0}, peak{0};
-  std::vector<uint8_t> start_due{0};
-  std::vector<uint32_t> counts(kNumCounts, 0);
-  const TransitionState state{index,      stage,      time,    weight, tr_rate,   waited,
-                              min_cadence, chosen,    lag,     prev_speed, prev_phase, still_s,
-                              moving,     peak,       start_due, counts};
+  OneAgentTransitions t(*lib, params, static_cast<int16_t>(lib->idle), 0.0f, true);
   auto step = [&](float v) {
-    speed[0] = v;
-    standing[0] = v < params.stop_speed_m_s ? 1 : 0;
-    transition_pass(crowd, speed, rate, standing, layer_clip, layer_weight, gait, phase, state);
-    fresh[0] = 0;
+    t.standing[0] = v < params.stop_speed_m_s ? 1 : 0;
+    t.step(v);
   };
+  const std::vector<uint32_t>& counts = t.counts;
   for (int f = 0; f < 30; ++f) step(0.0f);
   for (int f = 0; f < 60; ++f) step(0.9f * still);  // a creep, 1 s
   for (int f = 0; f < 30; ++f) step(0.0f);
