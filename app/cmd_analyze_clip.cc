@@ -196,9 +196,7 @@ void print_library(const ClipSet& set) {
   for (const std::string& c : lib->clip_names()) std::printf(" %s", c.c_str());
   std::printf("\n");
   for (const std::string& d : describe_doubts(*lib)) std::printf("  doubtful: %s\n", d.c_str());
-  const MediatorParams defaults;
-  for (const std::string& g :
-       describe_gaps(*lib, defaults.min_playback_rate, defaults.max_playback_rate)) {
+  for (const std::string& g : describe_gaps(*lib, MediatorParams{})) {
     std::printf("  gap: %s\n", g.c_str());
   }
   for (const std::string& l : describe_left_out(*lib)) std::printf("  left out: %s\n", l.c_str());

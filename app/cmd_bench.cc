@@ -415,7 +415,7 @@ void run_bench(const BenchOptions& o) {
   report.takes = describe_takes(library);
   report.left_out = describe_left_out(library);
   report.doubtful = describe_doubts(library);
-  report.gaps = describe_gaps(library, params.min_playback_rate, params.max_playback_rate);
+  report.gaps = describe_gaps(library, params);
   {
     BenchReport::Transitions t;
     const auto counts = session->mediator().transition_counts();

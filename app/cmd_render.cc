@@ -251,12 +251,8 @@ void run_render(RenderOptions& o) {
   for (const std::string& d : describe_doubts(session->library())) {
     std::fprintf(stderr, "render: doubtful: %s\n", d.c_str());
   }
-  {
-    const MediatorParams& mp = session->params();
-    for (const std::string& g :
-         describe_gaps(session->library(), mp.min_playback_rate, mp.max_playback_rate)) {
-      std::fprintf(stderr, "render: library gap: %s\n", g.c_str());
-    }
+  for (const std::string& g : describe_gaps(session->library(), session->params())) {
+    std::fprintf(stderr, "render: library gap: %s\n", g.c_str());
   }
   if (follow >= 0) check_agent_id(kCmd, session->setup(), follow, "--follow");
   if (kind == OutputKind::kFolder) {

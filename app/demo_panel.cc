@@ -271,9 +271,7 @@ void DemoApp::panel_clips() {
     ImGui::PopTextWrapPos();
   }
   // What the clips cannot play (no walk; a walk and a run too far apart in speed).
-  const MediatorParams& mp = session_->params();
-  const std::vector<std::string> gaps =
-      describe_gaps(session_->library(), mp.min_playback_rate, mp.max_playback_rate);
+  const std::vector<std::string> gaps = describe_gaps(session_->library(), session_->params());
   if (!gaps.empty()) {
     ImGui::Text("library gaps:");
     ImGui::PushTextWrapPos(0.0f);

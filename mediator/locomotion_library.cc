@@ -835,13 +835,14 @@ std::vector<std::string> describe_doubts(const LocomotionLibrary& library) {
   return lines;
 }
 
-std::vector<std::string> describe_gaps(const LocomotionLibrary& library, float min_playback_rate,
-                                       float max_playback_rate) {
+std::vector<std::string> describe_gaps(const LocomotionLibrary& library,
+                                       const MediatorParams& params) {
   std::vector<std::string> lines;
   if (library.forward_group < 0 ||
       library.forward_group >= static_cast<int>(library.groups.size())) {
     return lines;
   }
+  const float min_rate = params.min_playback_rate, max_rate = params.max_playback_rate;
   int walk = -1, run = -1;  // the fastest walk and the slowest run, by speed
   for (int c : library.groups[library.forward_group].clips) {
     const LocomotionClip& clip = library.clips[c];
@@ -860,22 +861,33 @@ std::vector<std::string> describe_gaps(const LocomotionLibrary& library, float m
                   "than %.2f m/s (%s, %.2f m/s, at the slowest playback rate, %.2fx) are shown "
                   "running slowly, blended with standing below that; a run's flight and push-off "
                   "at walking speeds float and slide (METRICS.md float_ratio, support slide)",
-                  r.speed_m_s * min_playback_rate, r.clip.name.c_str(), r.speed_m_s,
-                  min_playback_rate);
+                  r.speed_m_s * min_rate, r.clip.name.c_str(), r.speed_m_s, min_rate);
     lines.emplace_back(buf);
   } else if (walk >= 0 && run >= 0) {
     const LocomotionClip& w = library.clips[walk];
     const LocomotionClip& r = library.clips[run];
-    const float top = w.speed_m_s * max_playback_rate, bottom = r.speed_m_s * min_playback_rate;
+    const float top = w.speed_m_s * max_rate, bottom = r.speed_m_s * min_rate;
     if (top < bottom) {
       std::snprintf(buf, sizeof(buf),
                     "no clip plays alone between %.2f m/s (%s, %.2f m/s, at the fastest playback "
                     "rate, %.2fx) and %.2f m/s (%s, %.2f m/s, at the slowest, %.2fx): a walk and "
                     "a run are blended there, the walk's double support with the run's flight",
-                    top, w.clip.name.c_str(), w.speed_m_s, max_playback_rate, bottom,
-                    r.clip.name.c_str(), r.speed_m_s, min_playback_rate);
+                    top, w.clip.name.c_str(), w.speed_m_s, max_rate, bottom, r.clip.name.c_str(),
+                    r.speed_m_s, min_rate);
       lines.emplace_back(buf);
     }
+  }
+  if (walk >= 0 && run < 0) {
+    // The feedback pass's top speed: the fastest forward clip at the fastest rate, stretched.
+    const LocomotionClip& w = library.clips[walk];
+    const float top = w.speed_m_s * max_rate * (1.0f + params.max_stride_warp);
+    std::snprintf(buf, sizeof(buf),
+                  "no running clip: agents faster than %.2f m/s (%s, %.2f m/s, at the fastest "
+                  "playback rate, %.2fx) are slowed to it through feedback where the simulator "
+                  "takes it; a recorded crowd takes none, and its faster pedestrians' stance feet "
+                  "are dragged and land hard (METRICS.md support slide, limb pops)",
+                  top, w.clip.name.c_str(), w.speed_m_s, max_rate);
+    lines.emplace_back(buf);
   }
   return lines;
 }

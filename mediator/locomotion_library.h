@@ -13,6 +13,7 @@
 #include "animation/clip.h"
 #include "animation/mesh.h"
 #include "animation/segmentation.h"
+#include "mediator/params.h"
 
 namespace gk {
 
@@ -204,13 +205,14 @@ std::vector<std::string> describe_left_out(const LocomotionLibrary& library);
 // every gait clip is, a last line says the library is played as the naive mode plays it.
 std::vector<std::string> describe_doubts(const LocomotionLibrary& library);
 
-// What the library's forward clips cannot play, one line each, for a user to be told rather than
-// find out: no walking clip (every forward gait clip has a flight phase: walkers are shown
-// running slowly), or a walk and a run too far apart in speed for either to play alone in
-// between at the playback rate limits (a walk's double support blended with a run's flight).
-// Empty when neither.
-std::vector<std::string> describe_gaps(const LocomotionLibrary& library, float min_playback_rate,
-                                       float max_playback_rate);
+// What the library's forward clips cannot play with these parameters (their playback rate limits
+// and stride stretch), one line each, for a user to be told rather than find out: no walking
+// clip (every forward gait clip has a flight phase: walkers are shown running slowly), a walk and
+// a run too far apart in speed for either to play alone in between (a walk's double support
+// blended with a run's flight), or no running clip (faster agents are slowed through feedback,
+// and a recorded crowd's, which takes none, drag their feet). Empty when none of these.
+std::vector<std::string> describe_gaps(const LocomotionLibrary& library,
+                                       const MediatorParams& params);
 
 // True when the library has gait clips and the contact analysis of every one is doubtful: nothing
 // the mediator adds (foot locks, rate and phase matching, blends aligned on contacts) can be

@@ -205,25 +205,41 @@ TEST(DoubtfulClips, ALibraryWithOneSoundGaitClipKeepsTheMediator) {
   EXPECT_EQ(d.params().mode, MediatorMode::kNaive);
 }
 
-// What the clips cannot play is said: a run alone has no walk for walkers, and a walk and a run
-// too far apart in speed (the fastest walk at the fastest rate slower than the slowest run at the
+// What the clips cannot play is said: a run alone has no walk for walkers, a walk alone has no
+// run for runners (a replay's cannot be slowed through feedback), and a walk and a run too far
+// apart in speed (the fastest walk at the fastest rate slower than the slowest run at the
 // slowest) leave a band where only a blend of the two plays. Libraries that can play every speed
 // (the built-in set, subject 16's with its fast walk and jog) say nothing.
 TEST(DoubtfulClips, WhatALibraryCannotPlayIsSaid) {
   const MediatorParams p;
-  EXPECT_TRUE(describe_gaps(test::builtin_library(), p.min_playback_rate, p.max_playback_rate)
-                  .empty());
+  EXPECT_TRUE(describe_gaps(test::builtin_library(), p).empty());
   GK_REQUIRE_DATA("clips/bvh/cmu_09_11_run.bvh");
   GK_REQUIRE_DATA("clips/bvh/more/cmu_16_36_run_jog_mrl30.bvh");
   auto run = test::load_data_library({"clips/bvh/cmu_09_11_run.bvh"});
   ASSERT_TRUE(run.ok()) << run.message();
-  const auto run_gaps = describe_gaps(*run, p.min_playback_rate, p.max_playback_rate);
+  const auto run_gaps = describe_gaps(*run, p);
   ASSERT_EQ(run_gaps.size(), 1u);
   EXPECT_EQ(run_gaps[0].rfind("no walking clip", 0), 0u) << run_gaps[0];
+  auto walk_alone = test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh"});
+  ASSERT_TRUE(walk_alone.ok()) << walk_alone.message();
+  const auto walk_gaps = describe_gaps(*walk_alone, p);
+  ASSERT_EQ(walk_gaps.size(), 1u);
+  EXPECT_EQ(walk_gaps[0].rfind("no running clip", 0), 0u) << walk_gaps[0];
+  // Its top speed is the feedback's: the walk at the fastest rate, with the stride stretch.
+  float walk_speed = 0.0f;
+  for (const LocomotionClip& c : walk_alone->clips) {
+    if (c.gait) walk_speed = std::max(walk_speed, c.speed_m_s);
+  }
+  MediatorParams warped = p;
+  warped.max_stride_warp = 0.2f;
+  char top[64];
+  std::snprintf(top, sizeof(top), "faster than %.2f m/s",
+                walk_speed * p.max_playback_rate * 1.2f);
+  EXPECT_NE(describe_gaps(*walk_alone, warped)[0].find(top), std::string::npos);
   auto pair =
       test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});
   ASSERT_TRUE(pair.ok()) << pair.message();
-  const auto pair_gaps = describe_gaps(*pair, p.min_playback_rate, p.max_playback_rate);
+  const auto pair_gaps = describe_gaps(*pair, p);
   ASSERT_EQ(pair_gaps.size(), 1u);
   EXPECT_EQ(pair_gaps[0].rfind("no clip plays alone between", 0), 0u) << pair_gaps[0];
   // The band's ends: the walk at the fastest rate, the run at the slowest.
@@ -239,10 +255,12 @@ TEST(DoubtfulClips, WhatALibraryCannotPlayIsSaid) {
   std::snprintf(band, sizeof(band), "and %.2f m/s", slowest_run * p.min_playback_rate);
   EXPECT_NE(pair_gaps[0].find(band), std::string::npos) << pair_gaps[0];
   // Played faster, the walk reaches the run: no band.
-  EXPECT_TRUE(describe_gaps(*pair, p.min_playback_rate, 2.0f).empty());
+  MediatorParams faster = p;
+  faster.max_playback_rate = 2.0f;
+  EXPECT_TRUE(describe_gaps(*pair, faster).empty());
   auto s16 = test::subject16_library();
   ASSERT_TRUE(s16.ok()) << s16.message();
-  EXPECT_TRUE(describe_gaps(*s16, p.min_playback_rate, p.max_playback_rate).empty());
+  EXPECT_TRUE(describe_gaps(*s16, p).empty());
 }
 
 }  // namespace
