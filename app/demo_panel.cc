@@ -189,6 +189,12 @@ void DemoApp::panel_crowd() {
       }
     }
   }
+  // What the clips cannot play, said where the clips are chosen (the Clips section says what).
+  const size_t gaps = describe_gaps(session_->library(), session_->params()).size();
+  if (gaps > 0) {
+    ImGui::TextColored(ImVec4(1.0f, 0.7f, 0.3f, 1.0f), "%zu library gap%s: see Clips", gaps,
+                       gaps == 1 ? "" : "s");
+  }
   row("animation");
   int mode = static_cast<int>(session_->params().mode);
   if (ImGui::Combo("##mode", &mode, kModes, 3)) {
