@@ -55,7 +55,6 @@ struct NameInfo {
 
 bool is_separator(char c) { return c == '_' || c == '.' || c == '-' || c == ' '; }
 
-
 // Base words (separators removed) of each body part, from CMU/cgspeed, Mixamo, Rigify, Unity
 // humanoid, ASF (lfemur, ltibia) and plain (l_knee) conventions.
 Part part_of_base(const std::string& b, bool sided) {

@@ -82,6 +82,7 @@ bool DemoApp::rebuild() {
     }
     view_.reset();
     session_ = std::move(session);
+    gaps_.valid = false;
     view_ = std::move(view).value();
   } catch (const ExitRequest&) {
     status_ = last_failure();

@@ -126,6 +126,15 @@ class DemoApp {
   std::string note_;    // last parameter file saved / loaded
   std::unique_ptr<GlContext> context_;
   std::unique_ptr<CrowdSession> session_;
+  // What the loaded clips cannot play (describe_gaps), shown every frame in two places of the
+  // panel: made again only for a new session or new playback-rate limits or stride stretch.
+  struct LibraryGaps {
+    bool valid = false;
+    float min_rate = 0.0f, max_rate = 0.0f, stride_warp = 0.0f;
+    std::vector<std::string> lines;
+  };
+  LibraryGaps gaps_;
+  const std::vector<std::string>& library_gaps();
   std::unique_ptr<SceneView> view_;
   std::optional<OverlayHistory> history_, compare_history_;
   LiveMetrics metrics_;

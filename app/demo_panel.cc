@@ -190,7 +190,7 @@ void DemoApp::panel_crowd() {
     }
   }
   // What the clips cannot play, said where the clips are chosen (the Clips section says what).
-  const size_t gaps = describe_gaps(session_->library(), session_->params()).size();
+  const size_t gaps = library_gaps().size();
   if (gaps > 0) {
     ImGui::TextColored(ImVec4(1.0f, 0.7f, 0.3f, 1.0f), "%zu library gap%s: see Clips", gaps,
                        gaps == 1 ? "" : "s");
@@ -230,6 +230,16 @@ void DemoApp::apply_crowd() {
   crowd_.mode = std::string(mediator_mode_name(session_->params().mode));
   const MediatorParams keep = session_->params();
   if (rebuild()) session_->set_params(keep);
+}
+
+const std::vector<std::string>& DemoApp::library_gaps() {
+  const MediatorParams& p = session_->params();
+  if (!gaps_.valid || gaps_.min_rate != p.min_playback_rate ||
+      gaps_.max_rate != p.max_playback_rate || gaps_.stride_warp != p.max_stride_warp) {
+    gaps_ = {true, p.min_playback_rate, p.max_playback_rate, p.max_stride_warp,
+             describe_gaps(session_->library(), p)};
+  }
+  return gaps_.lines;
 }
 
 void DemoApp::panel_clips() {
@@ -277,7 +287,7 @@ void DemoApp::panel_clips() {
     ImGui::PopTextWrapPos();
   }
   // What the clips cannot play (no walk; a walk and a run too far apart in speed).
-  const std::vector<std::string> gaps = describe_gaps(session_->library(), session_->params());
+  const std::vector<std::string>& gaps = library_gaps();
   if (!gaps.empty()) {
     ImGui::Text("library gaps:");
     ImGui::PushTextWrapPos(0.0f);

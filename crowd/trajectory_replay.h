@@ -4,8 +4,8 @@
 // whose ground plane is (pos_x, pos_y)), or as CSV (comma or semicolon separated), with or without
 // a header row that names the frame (or time, in seconds), id, x and y columns (in any order,
 // among others); lines beginning with '#' are comments. Positions are resampled smoothly (C1: no
-// velocity jumps) to the simulation rate; velocity and theta are derived; agents appear and vanish with the data. Feedback
-// is ignored: the data is the truth.
+// velocity jumps) to the simulation rate; velocity and theta are derived; agents appear and
+// vanish with the data. Feedback is ignored: the data is the truth.
 //
 // Units: metres, unless the pedestrians would then move implausibly (their typical speed outside
 // 0.15-6 m/s) and centimetres or millimetres bring them to a walking pace; the replay's name then
