@@ -323,9 +323,11 @@ void add_analyze_clip_command(CLI::App& app) {
       "analyze-clip",
       "Analyse clips: unit scale, up axis (a Z-up or X-up BVH stood up along +y), IK-style feet "
       "re-parented under the shins (and a BVH foot without a toe joint given one at its End "
-      "Site), native speed and direction, gait cycle, foot contacts, foot-slide floor; a take's segments (idle, start, "
-      "steady, turn, stop) and the loops cut from it (without a steady stride: its steadiest "
-      "step and that step's mirror image).");
+      "Site), native speed and direction, gait cycle, foot contacts, foot-slide floor; a take's "
+      "segments (idle, start, steady, turn, stop) and the loops cut from it (without a steady "
+      "stride: its steadiest step and that step's mirror image); per file, what a library of it "
+      "alone keeps, leaves out, doubts, and cannot play (gaps: no walk, no run, a walk and a run "
+      "too far apart in speed).");
   cmd->add_option("files", opt->files,
                   "BVH, glTF or GLB files, folders of them, or 'builtin' for the built-in set")
       ->required();
