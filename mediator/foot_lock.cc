@@ -180,9 +180,10 @@ void transition(FootLock& s, const FootLockInput& in, const FootLockParams& p,
         return;
       }
       // A foot left behind by a turn or a drift while the clips stand re-plants with a short step,
-      // one foot at a time (walking, its own swing comes and takes the offset).
+      // one foot at a time, once the other is flat on the floor (walking, its own swing comes and
+      // takes the offset).
       const float drift = ground_length(s.target.x - in.anim_toe.x, s.target.z - in.anim_toe.z);
-      if (drift > p.step_distance_m && in.other_locked && !in.walking) {
+      if (drift > p.step_distance_m && in.other_locked && !in.other_on_heel && !in.walking) {
         pin_height(s, in);
         start_step(s, s.target + s.offset);
       }

@@ -22,9 +22,10 @@
 //   kLocked    -> kReleasing  release_foot_lock: the clips lift it (the other foot is not landing);
 //                             it sets off from rest (its rest carried on and shed)
 //   kLocked    -> kStepping   start_foot_step: left too far behind while the other foot is pinned
-//                             and the clips are not walking (their own swing re-places it); or
-//                             (pose synthesis) a leg that cannot reach its pin, walking or not,
-//                             while the clips keep weight on the foot and the other is pinned
+//                             flat and the clips are not walking (their own swing re-places it);
+//                             or (pose synthesis) a leg that cannot reach its pin, walking or
+//                             not, while the clips keep weight on the foot and the other is
+//                             pinned flat (not on its heel)
 //   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done (the
 //                             step's velocity is carried on and shed: no jump to the clip's)
 //   kStepping  -> kLocked     the step has landed: pinned at the clip's toe
@@ -96,6 +97,11 @@ struct FootLockInput {
   // keeps its weight (its lock) until the other has taken it over, as a trailing foot stays down
   // until the leading one is flat. (Running has a flight phase: no such wait.)
   bool other_landing = false;
+  // The other foot is pinned on its heel (toe up, rolling down onto its ball), walking or not: it
+  // has only just landed, and the body is not over it yet. This one starts no re-planting step
+  // until it is flat: a trailing foot that leaves the floor while the leading one is on its heel
+  // leaves the body on one heel, both toes in the air.
+  bool other_on_heel = false;
   float floor_toe_m = 0.0f;  // where planted toes are (library floor) [m]
   // A ball this slow over the ground is at rest (clip analysis's "still": half the travel speed,
   // at least its capture-jitter floor) [m/s]. A plant pins the foot once its ball is at rest, or

@@ -806,13 +806,14 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // the clips waits until the re-planting foot is down, never both feet in the air).
     // A trailing foot keeps its weight until the leading one is flat: pinned on its heel, the
     // leading foot is still rolling onto its ball (the clips' toe-off may come first).
+    // (Walking or not: a foot left behind by the standing clips does not step off either.)
     const Side other_side = static_cast<Side>(1 - side);
-    const bool other_on_heel =
-        other == FootLockState::kLocked && in.walking &&
+    in.other_on_heel =
+        other == FootLockState::kLocked &&
         on_heel(translation_of(world[skeleton_.ankle(other_side)]),
                 translation_of(world[skeleton_.toe(other_side)]),
                 library_.planted_ankle_m[1 - side], library_.planted_toe_m[1 - side]);
-    in.other_landing = other_on_heel || other == FootLockState::kStepping ||
+    in.other_landing = (in.other_on_heel && in.walking) || other == FootLockState::kStepping ||
                        (pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&
                         other_coming_down);
     in.floor_toe_m = library_.planted_toe_m[side];

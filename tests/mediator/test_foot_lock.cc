@@ -300,6 +300,40 @@ TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
   EXPECT_EQ(lock.state, FootLockState::kReleasing);
 }
 
+// A pinned foot the standing clips have left behind re-plants with a step, but not while the
+// other foot has only just landed on its heel: the body would stand on one heel, both toes in the
+// air. It steps on the first frame the other is flat.
+TEST(FootLock, NoReplantingStepWhileTheOtherFootIsOnItsHeel) {
+  FootLockParams params;
+  FootLock lock;
+  FootLockInput in;
+  in.anim_toe = in.anim_toe_prev = in.drawn_toe_prev = glm::vec3(0.0f, kFloor, 0.0f);
+  in.fresh = true;
+  in.plant = in.hold = true;
+  in.floor_toe_m = kFloor;
+  lock = step_foot_lock(lock, in, params, kDt).state;
+  ASSERT_EQ(lock.state, FootLockState::kLocked);
+  in.fresh = false;
+  in.other_locked = true;
+  in.other_on_heel = true;
+  // The standing clips turn away: their toe ends up well beyond the step distance from the pin.
+  const glm::vec3 away(params.step_distance_m * 1.5f, kFloor, 0.0f);
+  for (int f = 1; f <= 10; ++f) {
+    in.anim_toe_prev = in.anim_toe;
+    in.anim_toe = away * (static_cast<float>(f) / 10.0f);
+    in.anim_toe.y = kFloor;
+    const FootLockStep next = step_foot_lock(lock, in, params, kDt);
+    lock = next.state;
+    EXPECT_EQ(lock.state, FootLockState::kLocked) << f;
+    EXPECT_NEAR(horizontal(next.goal, glm::vec3(0.0f)), 0.0f, 1e-6f) << f;
+    in.drawn_toe_prev = next.goal;
+  }
+  in.other_on_heel = false;  // the other foot is flat now
+  in.anim_toe_prev = in.anim_toe;
+  lock = step_foot_lock(lock, in, params, kDt).state;
+  EXPECT_EQ(lock.state, FootLockState::kStepping);
+}
+
 TEST(FootLock, PlantedBelowTheClipsToeTheFootDoesNotRise) {
   // Drawn on the floor, 3 cm below the clip's toe, when it plants (the clip's toe stays 3 cm
   // above the floor): the pinned toe may not go up towards the clip's.
