@@ -142,6 +142,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.heel_pitch.assign(capacity * 2, 0.0f);
   locks_.heel_pitch_rate.assign(capacity * 2, 0.0f);
   locks_.lift_share.assign(capacity * 2, 0.0f);
+  locks_.lift_lost.assign(capacity * 2, 0.0f);
   // Joints whose local translation is the same in every frame of every clip (a BVH's offsets:
   // every joint but the root in the built-in and CMU sets) are not sampled per agent: that value
   // is kept in each thread's local translations once, and only the others are sampled (when they
@@ -649,7 +650,7 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
       locks_.lock[k] = fresh_foot_lock(locks_.drawn_toe[k]);
       locks_.anim_toe[k] = locks_.drawn_toe[k];
       locks_.heel_pitch[k] = locks_.heel_pitch_rate[k] = 0.0f;
-      locks_.lift_share[k] = 0.0f;
+      locks_.lift_share[k] = locks_.lift_lost[k] = 0.0f;
     }
   }
   prev_rot_valid_[slot] = track_rotation;
@@ -770,11 +771,21 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // read back (below) from two stores, which the load cannot take from the store buffer, and
     // it waits for every store before it (a streamed palette's too) to drain.
     const glm::vec3 drawn = translation_of(world[skeleton_.toe(static_cast<Side>(side))]);
-    const float lost = pl.gait_toe_y[side][slot] + root[3].y - drawn.y;
+    const float gw = pl.gait_weight[slot];
+    // With no gait clip left in the blend (the agent has just stopped) there is no gait toe to
+    // measure against: the height last taken away is kept, and the lift fades with its share.
+    // Measured against nothing, the lift of a foot still in the air vanished in one frame, the
+    // toe dropping onto the floor by centimetres.
+    float& lost_kept = locks_.lift_lost[k];
+    if (gw > 0.0f) {
+      lost_kept = pl.gait_toe_y[side][slot] + root[3].y - drawn.y;
+    } else if (pl.fresh[slot]) {
+      lost_kept = 0.0f;
+    }
+    const float lost = lost_kept;
     const bool other_carries =
         !letting_go &&
         locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
-    const float gw = pl.gait_weight[slot];
     const float share_goal =
         smoothstep01(other_carries ? gw / kGaitVoteWeight : 2.0f * gw);
     float& share = locks_.lift_share[k];

@@ -41,6 +41,9 @@ struct FootLocks {
   // Share of the swing height a standing blend takes away that is given back to this foot, 0..1
   // (it moves toward its goal over MediatorParams::lock_release_s, so the toe never jumps).
   std::vector<float> lift_share;
+  // The height [m] the standing blend takes from the toe against the gait clips' own (what the
+  // share gives back), kept from the last frame with a gait clip in the blend.
+  std::vector<float> lift_lost;
 };
 
 class PoseSynthesizer {

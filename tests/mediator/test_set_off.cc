@@ -169,5 +169,65 @@ TEST(SetOff, SlowStepsClearTheGroundAsTheWalkDoes) {
   for (float h : peaks) EXPECT_GT(h, 0.85f * lib.swing_height_m) << "swing height " << lib.swing_height_m;
 }
 
+// Slow walkers that stop dead (a jam's agent is stopped by the one in front), one every few
+// frames across a stride, so that some stop with a foot in the air: that foot comes down within
+// twice as fast as the walk itself lowers a foot (the factor METRICS.md's limb pops allow over
+// the clips' own), never in a frame. Before, the height a slow walk gives back
+// to a lifted foot (the lift share) was measured against the gait clips' toe, which is gone the
+// frame the last gait clip leaves the blend: a foot in the air dropped 5-7 cm in a frame.
+TEST(SetOff, ASuddenStopLowersALiftedFootAsTheWalkDoes) {
+  const LocomotionLibrary& lib = test::builtin_library();
+  const LocomotionClip& slowest = lib.clips[lib.groups[lib.forward_group].clips.front()];
+  const float speed = 0.3f * slowest.speed_m_s;
+  constexpr int kAgents = 24;
+  const int walk_frames = static_cast<int>(3.0f / kDt);
+  const int frames = walk_frames + kAgents * 2 + static_cast<int>(2.0f / kDt);
+  Mediator m(lib, MediatorParams{}, kAgents);
+  PoseSynthesizer ps(lib, kAgents, false);
+  std::vector<uint32_t> ids(kAgents);
+  std::vector<glm::vec2> p(kAgents), v(kAgents);
+  std::vector<float> th(kAgents, 0.0f);
+  for (int i = 0; i < kAgents; ++i) {
+    ids[i] = static_cast<uint32_t>(i + 1);
+    p[i] = glm::vec2(1.5f * static_cast<float>(i), 0.0f);
+  }
+  const Skeleton& sk = *lib.skeleton;
+  std::vector<float> last(kAgents * 2, 0.0f);
+  float walking_drop = 0.0f, stopping_drop = 0.0f;
+  int stopped_in_air = 0;
+  for (int f = 0; f < frames; ++f) {
+    for (int i = 0; i < kAgents; ++i) {
+      const bool stopped = f >= walk_frames + 2 * i;  // agent i stops 2 frames after agent i-1
+      v[i] = stopped ? glm::vec2(0.0f) : glm::vec2(0.0f, speed);
+      p[i] += v[i] * kDt;
+    }
+    ASSERT_TRUE(m.plan(AgentFrame{ids, p, v, th}, kDt).ok());
+    ps.run(m.plans(), kAgents, m.params(), kDt);
+    for (int i = 0; i < kAgents; ++i) {
+      const int slot = m.plans().slot_of_agent[i];
+      for (int s = 0; s < 2; ++s) {
+        const float y = translation_of(ps.world(slot)[sk.toe(static_cast<Side>(s))]).y;
+        const float drop = last[i * 2 + s] - y;
+        last[i * 2 + s] = y;
+        if (f < static_cast<int>(1.0f / kDt)) continue;  // settling in
+        const bool stopped = f >= walk_frames + 2 * i;
+        if (!stopped) {
+          walking_drop = std::max(walking_drop, drop);
+        } else {
+          stopping_drop = std::max(stopping_drop, drop);
+          if (f == walk_frames + 2 * i && y - lib.planted_toe_m[s] > 0.5f * lib.swing_height_m) {
+            ++stopped_in_air;
+          }
+        }
+      }
+    }
+  }
+  ASSERT_GT(walking_drop, 0.002f) << "the walk lowers its feet";
+  EXPECT_GE(stopped_in_air, 3) << "the test needs agents that stop with a foot up";
+  EXPECT_LE(stopping_drop, 2.0f * walking_drop)
+      << "fastest drop of a toe in a frame: walking " << walking_drop << " m, stopping "
+      << stopping_drop << " m";
+}
+
 }  // namespace
 }  // namespace gk
