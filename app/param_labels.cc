@@ -15,6 +15,7 @@ constexpr Label kLabels[] = {
     {"theta_halflife_s", "Look direction smoothing"},
     {"torsion_limit_deg", "Max torso twist"},
     {"lower_turn_rate_deg_s", "Max hip turn speed"},
+    {"lower_turn_accel_deg_s2", "Max hip turn speed-up"},
     {"blend_time_s", "Clip cross-fade time"},
     {"min_playback_rate", "Slowest playback"},
     {"max_playback_rate", "Fastest playback"},

@@ -71,6 +71,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   jitter_held_.assign(capacity, 0);
   root_heading_.assign(capacity, 0.0f);
   lower_target_.assign(capacity, 0.0f);
+  lower_yaw_rate_.assign(capacity, 0.0f);
   rel_dir_.assign(capacity, 0.0f);
   clip_weights_.assign(capacity * nc, 0.0f);
   scratch_target_.assign(capacity * nc, 0.0f);
@@ -118,6 +119,7 @@ void Mediator::init_slot(int slot, uint32_t id, const glm::vec2& p, const glm::v
   const float yaw = speed > params_.stop_speed_m_s ? heading2(vel) : th;
   plans_.lower_yaw[slot] = yaw;
   lower_target_[slot] = yaw;
+  lower_yaw_rate_[slot] = 0.0f;
   plans_.root_xz[slot] = usable_position(p) ? p : glm::vec2(0.0f);
   plans_.fresh[slot] = 1;
   // Variety: a random start phase and cadence, from the seed and the id (order-independent).
@@ -274,7 +276,8 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
   root_pass(crowd, sim_pos_, vel_, pl.standing, pl.lower_yaw, pl.root_xz, root_heading_,
             support_hold_allowed_ ? support_reach_ : std::span<const SupportReach>(), honoured,
             root_speed_, hold_, hold_scale_, still_at_, jitter_held_);
-  facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw, pl.upper_yaw,
+  facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw,
+              lower_yaw_rate_, pl.upper_yaw,
               rel_dir_, pl.layer_clip, pl.layer_weight);
   weights_pass(crowd, pl.speed_m_s, rel_dir_, tr_min_cadence_, {clip_weights_, scratch_target_},
                pl.layer_clip, pl.layer_weight, pl.blend_progress);

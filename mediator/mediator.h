@@ -130,6 +130,7 @@ class Mediator {
   bool degraded_ = false;                  // apm asked, naive played (a doubtful library)
   std::vector<float> fed_speed_;           // the speed the simulator was last given [m/s]
   std::vector<float> lower_target_;        // target facing of the lower body
+  std::vector<float> lower_yaw_rate_;      // its turn rate [rad/s]
   std::vector<float> clip_weights_;        // [slot * num_clips + clip]: faded weights
   std::vector<float> idle_time_;           // clock of the standing clip
   std::vector<float> cadence_scale_;       // per-agent variety

@@ -26,6 +26,11 @@ struct MediatorParams {
   // 3. Torso decoupling.
   float torsion_limit_deg = 60.0f;       // [deg] [Limit: 0..90] max twist pelvis -> upper chest
   float lower_turn_rate_deg_s = 300.0f;  // [deg/s] [Limit: 30..1440] max lower-body turn rate
+  // [deg/s^2] [Limit: 100..1000000] fastest change of that turn rate: a turn speeds up to it and
+  // slows down onto its heading over a couple of frames (300 deg/s in 0.03 s), and a velocity
+  // that zig-zags (a jam) never reverses the turn in one frame, which swung the knees around by
+  // metres per second in a frame. 1000000: no limit (the turn starts and stops at once).
+  float lower_turn_accel_deg_s2 = 10000.0f;
   // 4./6. Blending.
   float blend_time_s = 0.25f;  // [s] [Limit: 0.05..1] cross-fade duration on clip changes
   // 5. Playback rate and stride warping.

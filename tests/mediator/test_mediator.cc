@@ -419,6 +419,69 @@ TEST(Mediator, FeedsBackAWalkingDirectionTheLegsCanTake) {
   EXPECT_GE(off.max_off_deg, 40.0f);
 }
 
+// The lower body's turns speed up and slow down (lower_turn_accel_deg_s2): a simulator whose
+// velocity zig-zags (a jam's agents are pushed one way, then the other) never makes the lower body
+// reverse its turn in one frame, which snapped the knees around (limb pops); it still turns at up
+// to lower_turn_rate_deg_s, and comes to rest on a turn's new heading without overshooting it.
+struct YawTrace {
+  std::vector<float> yaw;  // lower_yaw per frame [rad]
+};
+YawTrace zig_zag(const MediatorParams& p, int frames, int period, float swing_deg) {
+  constexpr float kDt = 1.0f / 60.0f, kSpeed = 1.0f;
+  const LocomotionLibrary lib = test::builtin_library_without({"strafe", "backward"});
+  Mediator m(lib, p, 1);
+  const uint32_t id = 3;
+  glm::vec2 pos(0.0f);
+  YawTrace out;
+  for (int f = 0; f < frames; ++f) {
+    const float dir = glm::radians(period > 0 && (f / period) % 2 ? swing_deg : 0.0f);
+    const glm::vec2 vel = kSpeed * glm::vec2(std::sin(dir), std::cos(dir));
+    const float theta = dir;
+    EXPECT_TRUE(m.plan(AgentFrame{{&id, 1}, {&pos, 1}, {&vel, 1}, {&theta, 1}}, kDt,
+                       FeedbackPolicy::kIgnored)
+                    .ok());
+    out.yaw.push_back(m.plans().lower_yaw[m.plans().slot_of_agent[0]]);
+    pos += vel * kDt;
+  }
+  return out;
+}
+
+TEST(Mediator, LowerBodyTurnsSpeedUpAndSlowDown) {
+  constexpr float kDt = 1.0f / 60.0f;
+  auto rates = [&](const YawTrace& t) {
+    std::vector<float> w;
+    for (size_t f = 1; f < t.yaw.size(); ++f) w.push_back(wrap_pi(t.yaw[f] - t.yaw[f - 1]) / kDt);
+    return w;
+  };
+  auto largest_rate_change = [&](const std::vector<float>& w) {
+    float most = 0.0f;
+    for (size_t f = 1; f < w.size(); ++f) most = std::max(most, std::abs(w[f] - w[f - 1]));
+    return most;
+  };
+  MediatorParams p;
+  const float accel = glm::radians(p.lower_turn_accel_deg_s2);
+  const float rate = glm::radians(p.lower_turn_rate_deg_s);
+  // 60 degrees one way, then back, every 12 frames (0.2 s).
+  const std::vector<float> w = rates(zig_zag(p, 240, 12, 60.0f));
+  EXPECT_LE(largest_rate_change(w), accel * kDt * 1.001f + 1e-4f);
+  float fastest = 0.0f;
+  for (float x : w) fastest = std::max(fastest, std::abs(x));
+  EXPECT_LE(fastest, rate * 1.001f);
+  EXPECT_GE(fastest, 0.5f * rate) << "it still turns";
+  // Without the limit the same zig-zag reverses the turn within a frame.
+  MediatorParams unlimited = p;
+  unlimited.lower_turn_accel_deg_s2 = 1e6f;
+  EXPECT_GE(largest_rate_change(rates(zig_zag(unlimited, 240, 12, 60.0f))), 1.5f * rate);
+  // One 90 degree turn: reached, and passed no further than the target itself goes (the root's
+  // heading, with the stride's own sway, swings a few degrees past and back; the unlimited turn
+  // follows it exactly): the limit adds no overshoot of its own.
+  const YawTrace turn = zig_zag(p, 120, 60, 90.0f);
+  const YawTrace target = zig_zag(unlimited, 120, 60, 90.0f);
+  EXPECT_LE(*std::max_element(turn.yaw.begin(), turn.yaw.end()),
+            *std::max_element(target.yaw.begin(), target.yaw.end()) + glm::radians(0.1f));
+  EXPECT_NEAR(turn.yaw.back(), glm::radians(90.0f), glm::radians(1.0f));
+}
+
 TEST(Mediator, TurnFeedbackLeavesLibrariesWithDirectionClipsAlone) {
   // Forward and backward clips, walking straight while looking 100 degrees aside: the legs switch
   // to the backward clips, and the simulator must not be pulled along with them.
