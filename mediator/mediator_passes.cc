@@ -361,7 +361,8 @@ void facing_pass(const PassCrowd& c, std::span<const float> root_heading,
       // turn rate, fed forward: a jam's velocity jitters, and the body followed the jitter.)
       const float rate = glm::radians(P.lower_turn_rate_deg_s) * (standing ? 0.5f : 1.0f);
       const float accel = glm::radians(P.lower_turn_accel_deg_s2);
-      const float err = wrap_pi(target - psi);
+      float err = wrap_pi(target - psi);
+      if (!std::isfinite(err)) err = 0.0f;  // (the yaw and its rate are state: never NaN)
       const float half = 0.5f * accel * dt;
       const float stop = std::sqrt(half * half + 2.0f * accel * std::abs(err)) - half;
       const float want = std::copysign(std::min(rate, stop), err);
