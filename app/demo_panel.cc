@@ -487,10 +487,15 @@ void DemoApp::panel_params() {
     if (info.kind == ParamInfo::Kind::kBool) {
       changed |= ImGui::Checkbox("##value", &(p.*info.b));
     } else {
+      // A range over two decades or more (a halflife, an acceleration) is logarithmic: on a
+      // linear slider its default sat in the first pixel or two.
+      const bool decades = info.min_value > 0.0f && info.max_value >= 100.0f * info.min_value;
       char format[48];
-      std::snprintf(format, sizeof(format), "%%.3f %s", info.unit);
-      changed |= ImGui::SliderFloat("##value", &(p.*info.f), info.min_value, info.max_value,
-                                    format, ImGuiSliderFlags_AlwaysClamp);
+      std::snprintf(format, sizeof(format), info.max_value >= 1000.0f ? "%%.0f %s" : "%%.3f %s",
+                    info.unit);
+      changed |= ImGui::SliderFloat(
+          "##value", &(p.*info.f), info.min_value, info.max_value, format,
+          ImGuiSliderFlags_AlwaysClamp | (decades ? ImGuiSliderFlags_Logarithmic : 0));
     }
     if (label_hovered || ImGui::IsItemHovered()) {
       if (info.kind == ParamInfo::Kind::kBool) {
