@@ -268,19 +268,30 @@ TEST(FootLock, BallAtRestInTheClipsIsPinnedThoughTheBlendStillMovesIt) {
   }
 }
 
-// Walking, a trailing foot whose clip lifts it while the leading foot is still coming down keeps
-// its lock until the leading one is pinned; then it is let go.
-TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
+// A foot planted on the floor at the origin on its first frame: its lock, pinned there, and the
+// input that pinned it (no longer fresh), for a test to change.
+struct PinnedAtOrigin {
   FootLockParams params;
   FootLock lock;
   FootLockInput in;
-  in.anim_toe = in.anim_toe_prev = in.drawn_toe_prev = glm::vec3(0.0f, kFloor, 0.0f);
-  in.fresh = true;
-  in.plant = in.hold = true;
-  in.floor_toe_m = kFloor;
-  lock = step_foot_lock(lock, in, params, kDt).state;
+  PinnedAtOrigin() {
+    in.anim_toe = in.anim_toe_prev = in.drawn_toe_prev = glm::vec3(0.0f, kFloor, 0.0f);
+    in.fresh = true;
+    in.plant = in.hold = true;
+    in.floor_toe_m = kFloor;
+    lock = step_foot_lock(lock, in, params, kDt).state;
+    in.fresh = false;
+  }
+};
+
+// Walking, a trailing foot whose clip lifts it while the leading foot is still coming down keeps
+// its lock until the leading one is pinned; then it is let go.
+TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
+  PinnedAtOrigin pinned;
+  FootLockParams& params = pinned.params;
+  FootLock& lock = pinned.lock;
+  FootLockInput& in = pinned.in;
   ASSERT_EQ(lock.state, FootLockState::kLocked);
-  in.fresh = false;
   in.plant = in.hold = false;  // the clip lifts the foot
   in.other_landing = true;     // while the other is not pinned yet
   for (int f = 0; f < 3; ++f) {
@@ -304,16 +315,11 @@ TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
 // other foot has only just landed on its heel: the body would stand on one heel, both toes in the
 // air. It steps on the first frame the other is flat.
 TEST(FootLock, NoReplantingStepWhileTheOtherFootIsOnItsHeel) {
-  FootLockParams params;
-  FootLock lock;
-  FootLockInput in;
-  in.anim_toe = in.anim_toe_prev = in.drawn_toe_prev = glm::vec3(0.0f, kFloor, 0.0f);
-  in.fresh = true;
-  in.plant = in.hold = true;
-  in.floor_toe_m = kFloor;
-  lock = step_foot_lock(lock, in, params, kDt).state;
+  PinnedAtOrigin pinned;
+  FootLockParams& params = pinned.params;
+  FootLock& lock = pinned.lock;
+  FootLockInput& in = pinned.in;
   ASSERT_EQ(lock.state, FootLockState::kLocked);
-  in.fresh = false;
   in.other_locked = true;
   in.other_on_heel = true;
   // The standing clips turn away: their toe ends up well beyond the step distance from the pin.
