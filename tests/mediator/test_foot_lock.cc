@@ -288,9 +288,7 @@ struct PinnedAtOrigin {
 // its lock until the leading one is pinned; then it is let go.
 TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
   PinnedAtOrigin pinned;
-  FootLockParams& params = pinned.params;
-  FootLock& lock = pinned.lock;
-  FootLockInput& in = pinned.in;
+  auto& [params, lock, in] = pinned;
   ASSERT_EQ(lock.state, FootLockState::kLocked);
   in.plant = in.hold = false;  // the clip lifts the foot
   in.other_landing = true;     // while the other is not pinned yet
@@ -316,9 +314,7 @@ TEST(FootLock, TrailingFootWaitsForTheLeadingOneToLand) {
 // air. It steps on the first frame the other is flat.
 TEST(FootLock, NoReplantingStepWhileTheOtherFootIsOnItsHeel) {
   PinnedAtOrigin pinned;
-  FootLockParams& params = pinned.params;
-  FootLock& lock = pinned.lock;
-  FootLockInput& in = pinned.in;
+  auto& [params, lock, in] = pinned;
   ASSERT_EQ(lock.state, FootLockState::kLocked);
   in.other_locked = true;
   in.other_on_heel = true;
