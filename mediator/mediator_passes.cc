@@ -308,8 +308,9 @@ void root_pass(const PassCrowd& c, std::span<const glm::vec2> positions,
 void facing_pass(const PassCrowd& c, std::span<const float> root_heading,
                  std::span<const float> theta_unwrapped, std::span<const uint8_t> standing_in,
                  std::span<float> lower_target, std::span<float> lower_yaw,
-                 std::span<float> lower_yaw_rate, std::span<float> out_upper_yaw, std::span<float> out_rel_dir,
-                 std::span<const int16_t> layer_clip, std::span<const float> layer_weight) {
+                 std::span<float> lower_yaw_rate, std::span<float> out_upper_yaw,
+                 std::span<float> out_rel_dir, std::span<const int16_t> layer_clip,
+                 std::span<const float> layer_weight) {
   const LocomotionLibrary& lib = c.library;
   const MediatorParams& P = c.params;
   const bool apm = is_apm(c);
@@ -355,25 +356,12 @@ void facing_pass(const PassCrowd& c, std::span<const float> root_heading,
         if (wsum > 0.0f) target -= off / wsum;
       }
       lower_target[slot] = target;
-      // The turn speeds up and slows down by at most accel (lower_turn_accel_deg_s2), toward the
-      // rate from which slowing down frame by frame (by accel * dt each) stops at the target:
-      // v dt + (v - a dt) dt + ... = v^2 / 2a + v dt / 2 = |err|. (Not also the target's own
-      // turn rate, fed forward: a jam's velocity jitters, and the body followed the jitter.)
+      // The turn speeds up and slows down (lower_turn_accel_deg_s2): a jam's zig-zagging
+      // velocity never reverses it in a frame. (Not also the target's own turn rate fed
+      // forward: the body then followed the jitter again.)
       const float rate = glm::radians(P.lower_turn_rate_deg_s) * (standing ? 0.5f : 1.0f);
-      const float accel = glm::radians(P.lower_turn_accel_deg_s2);
-      float err = wrap_pi(target - psi);
-      if (!std::isfinite(err)) err = 0.0f;  // (the yaw and its rate are state: never NaN)
-      const float half = 0.5f * accel * dt;
-      const float stop = std::sqrt(half * half + 2.0f * accel * std::abs(err)) - half;
-      const float want = std::copysign(std::min(rate, stop), err);
-      float& w = lower_yaw_rate[slot];
-      w = approach(w, want, accel * dt);
-      if (std::abs(err) <= std::abs(w) * dt && err * w >= 0.0f && std::abs(w) <= accel * dt) {
-        psi = target;
-        w = 0.0f;
-      } else {
-        psi = wrap_pi(psi + w * dt);
-      }
+      turn_toward(psi, lower_yaw_rate[slot], target, rate, glm::radians(P.lower_turn_accel_deg_s2),
+                  dt);
     }
     lower_yaw[slot] = psi;
     out_upper_yaw[slot] = apm ? theta : psi;

@@ -73,11 +73,25 @@ inline float approach(float a, float b, float max_step) {
   return a + std::clamp(b - a, -max_step, max_step);
 }
 
-// Moves angle a toward b by at most max_step (shortest way round).
-inline float approach_angle(float a, float b, float max_step) {
-  const float d = wrap_pi(b - a);
-  if (std::abs(d) <= max_step) return b;
-  return a + (d > 0.0f ? max_step : -max_step);
+// Turns `angle` [rad] toward `target` (the shortest way round) over dt [s] at a turn `rate`
+// [rad/s] that changes by at most accel * dt per step and never exceeds max_rate: it speeds up,
+// and slows down so as to stop on the target, from the rate at which braking step by step covers
+// what is left (v dt + (v - a dt) dt + ... = v^2 / 2a + v dt / 2 = |error|); once within that last
+// step it lands on the target at rest. A target that is not a number turns nothing (angle and
+// rate are carried state). A huge accel turns at max_rate and stops at once.
+inline void turn_toward(float& angle, float& rate, float target, float max_rate, float accel,
+                        float dt) {
+  if (!std::isfinite(target)) target = angle;
+  const float err = wrap_pi(target - angle);
+  const float half = 0.5f * accel * dt;
+  const float stop = std::sqrt(half * half + 2.0f * accel * std::abs(err)) - half;
+  rate = approach(rate, std::copysign(std::min(max_rate, stop), err), accel * dt);
+  if (std::abs(err) <= std::abs(rate) * dt && err * rate >= 0.0f && std::abs(rate) <= accel * dt) {
+    angle = target;
+    rate = 0.0f;
+  } else {
+    angle = wrap_pi(angle + rate * dt);
+  }
 }
 
 }  // namespace gk

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -480,6 +481,24 @@ TEST(Mediator, LowerBodyTurnsSpeedUpAndSlowDown) {
   EXPECT_LE(*std::max_element(turn.yaw.begin(), turn.yaw.end()),
             *std::max_element(target.yaw.begin(), target.yaw.end()) + glm::radians(0.1f));
   EXPECT_NEAR(turn.yaw.back(), glm::radians(90.0f), glm::radians(1.0f));
+}
+
+// turn_toward alone: a turn whose target is not a number turns nothing and keeps its state
+// usable; from rest, a quarter turn is reached exactly and at rest.
+TEST(Springs, TurnTowardKeepsItsStateAndLandsAtRest) {
+  float angle = 0.25f, rate = 2.0f;
+  turn_toward(angle, rate, std::numeric_limits<float>::quiet_NaN(), 5.0f, 100.0f, 1.0f / 60.0f);
+  EXPECT_TRUE(std::isfinite(angle) && std::isfinite(rate));
+  angle = rate = 0.0f;
+  const float target = 0.5f * std::numbers::pi_v<float>;
+  for (int f = 0; f < 600 && !(angle == target && rate == 0.0f); ++f) {
+    const float before = angle;
+    turn_toward(angle, rate, target, 5.0f, 100.0f, 1.0f / 60.0f);
+    EXPECT_LE(angle, target) << f;
+    EXPECT_GE(angle, before) << f;
+  }
+  EXPECT_EQ(angle, target);
+  EXPECT_EQ(rate, 0.0f);
 }
 
 TEST(Mediator, TurnFeedbackLeavesLibrariesWithDirectionClipsAlone) {
