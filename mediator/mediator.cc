@@ -80,9 +80,9 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   reach_boost_.assign(capacity, 1.0f);
   tr_index_.assign(capacity, -1);
   tr_stage_.assign(capacity, TransitionStage::kNone);
-  for (auto* v : {&tr_time_, &tr_weight_, &tr_waited_, &tr_min_cadence_, &tr_chosen_speed_,
-                  &tr_lag_, &tr_prev_speed_, &tr_prev_phase_, &tr_still_, &tr_moving_,
-                  &tr_peak_speed_}) {
+  for (auto* v :
+       {&tr_time_, &tr_weight_, &tr_waited_, &tr_min_cadence_, &tr_chosen_speed_, &tr_lag_,
+        &tr_prev_speed_, &tr_prev_phase_, &tr_still_, &tr_moving_, &tr_peak_speed_}) {
     v->assign(capacity, 0.0f);
   }
   tr_rate_.assign(capacity, 1.0f);
@@ -277,8 +277,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
             support_hold_allowed_ ? support_reach_ : std::span<const SupportReach>(), honoured,
             root_speed_, hold_, hold_scale_, still_at_, jitter_held_);
   facing_pass(crowd, root_heading_, theta_, pl.standing, lower_target_, pl.lower_yaw,
-              lower_yaw_rate_, pl.upper_yaw,
-              rel_dir_, pl.layer_clip, pl.layer_weight);
+              lower_yaw_rate_, pl.upper_yaw, rel_dir_, pl.layer_clip, pl.layer_weight);
   weights_pass(crowd, pl.speed_m_s, rel_dir_, tr_min_cadence_, {clip_weights_, scratch_target_},
                pl.layer_clip, pl.layer_weight, pl.blend_progress);
   rate_phase_pass(crowd, pl.layer_clip, pl.layer_weight, pl.speed_m_s, cadence_scale_, pl.lower_yaw,
@@ -288,8 +287,7 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                   pl.layer_weight, pl.gait_weight, pl.phase,
                   {tr_index_, tr_stage_, tr_time_, tr_weight_, tr_rate_, tr_waited_,
                    tr_min_cadence_, tr_chosen_speed_, tr_lag_, tr_prev_speed_, tr_prev_phase_,
-                   tr_still_, tr_moving_, tr_peak_speed_, tr_start_due_, tr_counts_,
-                   reach_boost_});
+                   tr_still_, tr_moving_, tr_peak_speed_, tr_start_due_, tr_counts_, reach_boost_});
   contacts_pass(crowd, pl.layer_clip, pl.layer_weight, pl.phase, idle_time_, tr_time_,
                 pl.gait_weight, pl.playback_rate, tr_rate_, pl.layer_time_s,
                 {{pl.plant[0], pl.plant[1]},

@@ -193,8 +193,9 @@ void root_pass(const PassCrowd& crowd, std::span<const glm::vec2> positions,
 void facing_pass(const PassCrowd& crowd, std::span<const float> root_heading,
                  std::span<const float> theta, std::span<const uint8_t> standing,
                  std::span<float> lower_target, std::span<float> lower_yaw,
-                 std::span<float> lower_yaw_rate, std::span<float> out_upper_yaw, std::span<float> out_rel_dir,
-                 std::span<const int16_t> layer_clip, std::span<const float> layer_weight);
+                 std::span<float> lower_yaw_rate, std::span<float> out_upper_yaw,
+                 std::span<float> out_rel_dir, std::span<const int16_t> layer_clip,
+                 std::span<const float> layer_weight);
 
 // --- weights ------------------------------------------------------------------------------------
 // Per slot [slot * num_clips + clip]: the faded clip weights (carried) and the target ones.

@@ -824,9 +824,9 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
         on_heel(translation_of(world[skeleton_.ankle(other_side)]),
                 translation_of(world[skeleton_.toe(other_side)]),
                 library_.planted_ankle_m[1 - side], library_.planted_toe_m[1 - side]);
-    in.other_landing = (in.other_on_heel && in.walking) || other == FootLockState::kStepping ||
-                       (pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked &&
-                        other_coming_down);
+    in.other_landing =
+        (in.other_on_heel && in.walking) || other == FootLockState::kStepping ||
+        (pl.double_support[slot] >= 0.5f && other != FootLockState::kLocked && other_coming_down);
     in.floor_toe_m = library_.planted_toe_m[side];
     in.still_speed_m_s = still_speed_m_s(pl.speed_m_s[slot]);
     in.clip_speed_m_s = pl.clip_toe_speed[side][slot];

@@ -233,8 +233,7 @@ TEST(DoubtfulClips, WhatALibraryCannotPlayIsSaid) {
   MediatorParams warped = p;
   warped.max_stride_warp = 0.2f;
   char top[64];
-  std::snprintf(top, sizeof(top), "faster than %.2f m/s",
-                walk_speed * p.max_playback_rate * 1.2f);
+  std::snprintf(top, sizeof(top), "faster than %.2f m/s", walk_speed * p.max_playback_rate * 1.2f);
   EXPECT_NE(describe_gaps(*walk_alone, warped)[0].find(top), std::string::npos);
   auto pair =
       test::load_data_library({"clips/bvh/cmu_07_01_walk.bvh", "clips/bvh/cmu_09_11_run.bvh"});

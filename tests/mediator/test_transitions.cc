@@ -267,8 +267,8 @@ struct OneAgentTransitions {
       prev_speed{0}, prev_phase{0}, still{0}, moving{0}, peak{0};
   std::vector<uint8_t> start_due{0};
   std::vector<uint32_t> counts = std::vector<uint32_t>(kNumCounts, 0);
-  const TransitionState state{index,       stage,  time, weight,     tr_rate,    waited,
-                              min_cadence, chosen, lag,  prev_speed, prev_phase, still,
+  const TransitionState state{index,       stage,  time,      weight,     tr_rate,    waited,
+                              min_cadence, chosen, lag,       prev_speed, prev_phase, still,
                               moving,      peak,   start_due, counts};
 };
 
