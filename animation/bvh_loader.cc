@@ -240,6 +240,7 @@ Result<Clip> BvhParser::parse_motion(float scale) {
   if (std::abs(clip.fps - std::round(clip.fps)) < 0.01f) clip.fps = std::round(clip.fps);
   clip.num_frames = static_cast<int>(frames);
   clip.num_joints = num_joints;
+  clip.sampled_capture = true;  // motion capture sampled at the frame rate
   clip.rotations.resize(static_cast<size_t>(frames) * num_joints);
   clip.translations.resize(static_cast<size_t>(frames) * num_joints);
   std::vector<float> values(num_channels_);

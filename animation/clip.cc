@@ -43,6 +43,106 @@ Status validate_clip(const Clip& clip, const Skeleton& skeleton) {
   return Status::Ok();
 }
 
+namespace {
+
+// The slope at a sample between steps a and b (uniform spacing) that keeps a cubic through the
+// samples monotone between them (Fritsch and Butland: the harmonic mean of two steps the same
+// way, flat at a turn), so it never overshoots a sample: a foot that lands in the capture does not
+// dip through the floor and back between two frames.
+inline float monotone_slope(float a, float b) {
+  return a * b > 0.0f ? 2.0f * a * b / (a + b) : 0.0f;
+}
+
+// A monotone cubic Hermite through p0 p1 p2 p3 (uniform spacing) at u in [0, 1] between p1 and
+// p2, per component, on differences: a constant track stays exactly constant.
+template <class V>
+V monotone_cubic(const V& p0, const V& p1, const V& p2, const V& p3, float u) {
+  V out = p1;
+  for (int c = 0; c < V::length(); ++c) {
+    const float d0 = p1[c] - p0[c], d = p2[c] - p1[c], d2 = p3[c] - p2[c];
+    const float m1 = monotone_slope(d0, d), m2 = monotone_slope(d, d2);
+    out[c] = p1[c] + u * (m1 + u * (3.0f * d - 2.0f * m1 - m2 + u * (m1 + m2 - 2.0f * d)));
+  }
+  return out;
+}
+
+}  // namespace
+
+Clip upsample_clip(const Clip& clip, int factor, const Skeleton& skeleton) {
+  const int n = clip.num_frames, J = clip.num_joints;
+  if (factor <= 1 || n < 2 || J != skeleton.num_joints()) return clip;
+  Clip out = clip;
+  out.fps = clip.fps * static_cast<float>(factor);
+  out.num_frames = clip.loops ? n * factor : (n - 1) * factor + 1;
+  const size_t count = static_cast<size_t>(out.num_frames) * J;
+  out.rotations.assign(count, glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+  out.translations.assign(count, glm::vec3(0.0f));
+  // A root's ground travel over one loop: the frame after the last is the first moved on by it
+  // (an in-place loop's is about zero).
+  std::vector<glm::vec3> loop_travel(J, glm::vec3(0.0f));
+  if (clip.loops) {
+    for (int j = 0; j < J; ++j) {
+      if (skeleton.parents[j] >= 0) continue;
+      const glm::vec3 d = (clip.frame_translations(n - 1)[j] - clip.frame_translations(0)[j]) *
+                          (static_cast<float>(n) / static_cast<float>(n - 1));
+      loop_travel[j] = glm::vec3(d.x, 0.0f, d.z);
+    }
+  }
+  // Frame i's sample of joint j, i beyond the ends wrapped (a loop) or extended along the end's
+  // own velocity (a take: no kink at its ends).
+  auto trans = [&](int i, int j) {
+    if (i >= 0 && i < n) return clip.frame_translations(i)[j];
+    if (clip.loops) {
+      return i < 0 ? clip.frame_translations(i + n)[j] - loop_travel[j]
+                   : clip.frame_translations(i - n)[j] + loop_travel[j];
+    }
+    const int e = i < 0 ? 0 : n - 1, in = i < 0 ? 1 : n - 2;
+    return 2.0f * clip.frame_translations(e)[j] - clip.frame_translations(in)[j];
+  };
+  auto rot = [&](int i, int j) {
+    if (i >= 0 && i < n) return clip.frame_rotations(i)[j];
+    if (clip.loops) return clip.frame_rotations(((i % n) + n) % n)[j];
+    // Mirrored about the end: the end's rotation turned on by its last step (q_e * inv(q_in) *
+    // q_e).
+    const int e = i < 0 ? 0 : n - 1, in = i < 0 ? 1 : n - 2;
+    const glm::quat qe = clip.frame_rotations(e)[j];
+    return glm::normalize(qe * glm::inverse(clip.frame_rotations(in)[j]) * qe);
+  };
+  for (int f = 0; f < out.num_frames; ++f) {
+    const int i = f / factor;
+    const float u = static_cast<float>(f % factor) / static_cast<float>(factor);
+    glm::quat* r_out = out.rotations.data() + static_cast<size_t>(f) * J;
+    glm::vec3* t_out = out.translations.data() + static_cast<size_t>(f) * J;
+    if (u == 0.0f) {  // a source frame: kept exactly
+      const int src = clip.loops ? i % n : i;
+      std::copy_n(clip.frame_rotations(src), J, r_out);
+      std::copy_n(clip.frame_translations(src), J, t_out);
+      continue;
+    }
+    for (int j = 0; j < J; ++j) {
+      t_out[j] = monotone_cubic(trans(i - 1, j), trans(i, j), trans(i + 1, j), trans(i + 2, j), u);
+      // The four rotations on the hemisphere of the second (q and -q are one rotation), each
+      // component on the monotone cubic, normalised: for samples this dense, close to a
+      // spherical curve, and never turned beyond the frames either side.
+      const glm::quat q1 = rot(i, j);
+      glm::vec4 v[4];
+      for (int k = 0; k < 4; ++k) {
+        const glm::quat q = k == 1 ? q1 : rot(i - 1 + k, j);
+        const float s = glm::dot(q, q1) < 0.0f ? -1.0f : 1.0f;
+        v[k] = s * glm::vec4(q.x, q.y, q.z, q.w);
+      }
+      if (v[0] == v[1] && v[2] == v[1] && v[3] == v[1]) {  // a still joint stays exactly still
+        r_out[j] = q1;
+        continue;
+      }
+      const glm::vec4 c = monotone_cubic(v[0], v[1], v[2], v[3], u);
+      const float len = glm::length(c);
+      r_out[j] = len > 1e-6f ? glm::quat(c.w / len, c.x / len, c.y / len, c.z / len) : q1;
+    }
+  }
+  return out;
+}
+
 namespace internal {
 
 void local_to_model(const Skeleton& skeleton, const glm::quat* rotations,

@@ -27,6 +27,10 @@ struct Clip {
   // Loop clips are sampled with wrap-around: frame num_frames-1 is followed by frame 0 (loaders
   // drop a final frame that duplicates the first).
   bool loops = true;
+  // The frames sample a continuous motion (a capture: BVH), not keys meant to be joined by
+  // straight segments (glTF's LINEAR interpolation): played below 60 fps, it is upsampled on a
+  // monotone cubic (upsample_clip).
+  bool sampled_capture = false;
 
   float duration_s() const {
     return loops ? num_frames / fps : (num_frames > 1 ? (num_frames - 1) / fps : 0.0f);
@@ -40,6 +44,16 @@ struct Clip {
 };
 
 Status validate_clip(const Clip& clip, const Skeleton& skeleton);
+
+// The clip at `factor` times its frame rate, the new frames on a monotone cubic through the
+// source frames (per channel, Fritsch-Butland slopes: smooth, and never beyond the samples either
+// side; rotations on one hemisphere, normalised): a 24 or 30 fps capture played at 60 Hz then
+// moves smoothly between its samples instead of in straight segments whose velocity jumps at
+// every source frame. Every source frame is kept exactly; the duration is the same. Beyond a
+// take's ends the curve continues the end's own velocity; a loop wraps, a root moved on by the
+// loop's ground travel. factor <= 1 (or a clip that does not match the skeleton) returns the clip
+// unchanged.
+Clip upsample_clip(const Clip& clip, int factor, const Skeleton& skeleton);
 
 // A loaded or generated set: one skeleton, its clips, and optionally a skinned mesh.
 struct SkinnedMesh;

@@ -115,6 +115,7 @@ Clip clip_like(const Clip& take, int frames, bool loops) {
   c.num_frames = frames;
   c.num_joints = take.num_joints;
   c.loops = loops;
+  c.sampled_capture = take.sampled_capture;
   return c;
 }
 

@@ -92,7 +92,7 @@ CoarseRig make_coarse_rig(const LocomotionLibrary& library) {
   rig.clips.reserve(library.clips.size());
   const size_t K = coarse.size();
   for (const LocomotionClip& lc : library.clips) {
-    const Clip& c = lc.clip;
+    const Clip& c = lc.playback();
     Clip out;
     out.name = c.name;
     out.source = c.source;

@@ -455,6 +455,18 @@ void raise_clip(LocomotionClip* lc, float dy) {
 
 // A standing clip taken from the frame of a gait clip where both feet are planted closest
 // together, for libraries without an idle (e.g. a walk and a run).
+// How many times a clip is upsampled for playback (LocomotionClip::played): a capture below
+// kPlaybackFps to at least that (24 fps to 72, 30 fps to 60), at most kMaxUpsampling times (a
+// file that claims a frame every few seconds is not made into millions of frames); authored keys
+// never (a glTF's LINEAR keys are meant to be joined by straight segments), nor a capture at 60
+// fps or more.
+int playback_upsampling(const Clip& c) {
+  constexpr float kPlaybackFps = 60.0f;
+  constexpr int kMaxUpsampling = 4;
+  if (!c.sampled_capture || !(c.fps > 0.0f) || c.fps >= kPlaybackFps) return 1;
+  return std::min(kMaxUpsampling, static_cast<int>(std::ceil(kPlaybackFps / c.fps - 1e-3f)));
+}
+
 LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
   const Clip& g = gait.clip;
   std::vector<glm::mat4> model(sk.num_joints());
@@ -974,6 +986,7 @@ Clip retarget_clip(const Clip& clip, const Skeleton& src, const Skeleton& dst, f
   out.num_frames = clip.num_frames;
   out.num_joints = dst.num_joints();
   out.loops = clip.loops;
+  out.sampled_capture = clip.sampled_capture;
   const int nd = dst.num_joints();
   const std::vector<int> map = retarget_joint_map(src, dst);
   // Rest-pose aware: a mapped joint takes the source joint's model-space rotation relative to the
@@ -1519,6 +1532,10 @@ Result<LocomotionLibrary> build_locomotion_library(const std::vector<ClipSet>& s
   }
   for (LocomotionClip& c : lib.clips) {
     if (c.gait) set_lift_phases(&c);
+  }
+  for (LocomotionClip& c : lib.clips) {
+    const int k = playback_upsampling(c.clip);
+    if (k > 1) c.played = upsample_clip(c.clip, k, sk);
   }
   {
     const float hip_height = 0.5f * (lib.leg_length_m[0] + lib.leg_length_m[1] +

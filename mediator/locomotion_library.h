@@ -21,6 +21,13 @@ inline constexpr int kPhaseTableSize = 64;
 
 struct LocomotionClip {
   Clip clip;  // in place, facing +z, on the library skeleton
+  // The clip as pose synthesis samples it where that is not `clip` itself: a capture below 60 fps
+  // (Clip::sampled_capture) upsampled on a monotone cubic through its frames (upsample_clip), so
+  // its joints do not move in straight segments whose velocity jumps at every captured frame;
+  // empty otherwise. Sampled at a captured frame's time it is that frame; clip analysis, the foot
+  // flags and the metrics' references all read `clip`, at the frames as captured.
+  Clip played;
+  const Clip& playback() const { return played.num_frames > 0 ? played : clip; }
   // The take as captured, with its root motion, on the library skeleton and floor (empty for a
   // clip authored in place): what the metrics' clip references and floors play.
   Clip source;

@@ -368,7 +368,7 @@ void PoseSynthesizer::prefetch_agent(const AnimationPlans& pl, int slot,
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     if (pl.layer_weight[slot * kMaxBlendLayers + k] <= 0.0f) continue;
     const int c = pl.layer_clip[slot * kMaxBlendLayers + k];
-    const Clip& clip = coarse ? coarse_.clips[c] : library_.clips[c].clip;
+    const Clip& clip = coarse ? coarse_.clips[c] : library_.clips[c].playback();
     const float f = pl.layer_time_s[slot * kMaxBlendLayers + k] * clip.fps;
     if (!(f >= 0.0f && f < static_cast<float>(clip.num_frames))) continue;  // a wrap: not guessed
     const int i0 = static_cast<int>(f);
@@ -432,7 +432,7 @@ void PoseSynthesizer::sample_layers(const AnimationPlans& pl, int slot, bool coa
     // over the stride's last fifth the pose one stride earlier is blended in, and the wrap to the
     // stride's start joins exactly.
     const LocomotionClip& lc = library_.clips[c];
-    const Clip* clip = coarse ? &coarse_.clips[c] : &lc.clip;
+    const Clip* clip = coarse ? &coarse_.clips[c] : &lc.playback();
     const float seam = take_seam(lc, time);
     clip_of[num_samples] = clip;
     time_of[num_samples] = time;
