@@ -139,6 +139,7 @@ PoseSynthesizer::PoseSynthesizer(const LocomotionLibrary& library, size_t capaci
   locks_.lock.assign(capacity * 2, FootLock());
   locks_.anim_toe.assign(capacity * 2, glm::vec3(0.0f));
   locks_.drawn_toe.assign(capacity * 2, glm::vec3(0.0f));
+  locks_.drawn_ankle.assign(capacity * 2, glm::vec3(0.0f));
   locks_.heel_pitch.assign(capacity * 2, 0.0f);
   locks_.heel_pitch_rate.assign(capacity * 2, 0.0f);
   locks_.lift_share.assign(capacity * 2, 0.0f);
@@ -405,6 +406,7 @@ void PoseSynthesizer::hold_agent(const AnimationPlans& pl, int slot) {
   for (int side = 0; side < 2; ++side) {
     const size_t k = static_cast<size_t>(slot) * 2 + side;
     locks_.drawn_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
+    locks_.drawn_ankle[k] += glm::vec3(delta.x, 0.0f, delta.y);
     locks_.anim_toe[k] += glm::vec3(delta.x, 0.0f, delta.y);
   }
 }
@@ -634,10 +636,13 @@ void PoseSynthesizer::finish_pose(int slot, const glm::mat4* world, const glm::q
     }
   }
   rot_change_[slot] = change;
-  // The toes as drawn, in every mode: foot locking starts from them (also after being off).
+  // The toes (and ankles) as drawn, in every mode: foot locking starts from them (also after
+  // being off).
   for (int side = 0; side < 2; ++side) {
     locks_.drawn_toe[static_cast<size_t>(slot) * 2 + side] =
         translation_of(world[skeleton_.toe(static_cast<Side>(side))]);
+    locks_.drawn_ankle[static_cast<size_t>(slot) * 2 + side] =
+        translation_of(world[skeleton_.ankle(static_cast<Side>(side))]);
   }
   if (!locking) {
     // Foot locks (and the pelvis drop and raised heels that serve them) start afresh from the
@@ -818,11 +823,14 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // A trailing foot keeps its weight until the leading one is flat: pinned on its heel, the
     // leading foot is still rolling onto its ball (the clips' toe-off may come first).
     // (Walking or not: a foot left behind by the standing clips does not step off either.)
-    const Side other_side = static_cast<Side>(1 - side);
+    // The other foot as it was drawn (pinned, its heel on or off the floor), not as the clips
+    // have it: a walk blended with the standing pose puts a planted toe above its heel, and a
+    // foot held on such a "heel" kept this one pinned as its ball rose with the clips' swing
+    // (up to 17 cm, for a third of a second).
+    const size_t other_k = static_cast<size_t>(slot) * 2 + (1 - side);
     in.other_on_heel =
-        other == FootLockState::kLocked &&
-        on_heel(translation_of(world[skeleton_.ankle(other_side)]),
-                translation_of(world[skeleton_.toe(other_side)]),
+        other == FootLockState::kLocked && !pl.fresh[slot] &&
+        on_heel(locks_.drawn_ankle[other_k], locks_.drawn_toe[other_k],
                 library_.planted_ankle_m[1 - side], library_.planted_toe_m[1 - side]);
     in.other_landing =
         (in.other_on_heel && in.walking) || other == FootLockState::kStepping ||

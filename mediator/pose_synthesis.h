@@ -36,6 +36,7 @@ struct FootLocks {
   std::vector<FootLock> lock;          // the lock state machine (mediator/foot_lock.h)
   std::vector<glm::vec3> anim_toe;     // the clip's (unlocked) toe position last frame [m]
   std::vector<glm::vec3> drawn_toe;    // the toe as drawn last frame (after IK) [m]
+  std::vector<glm::vec3> drawn_ankle;  // the ankle as drawn last frame (after IK) [m]
   std::vector<float> heel_pitch;       // heel raised about the ball by the pivot [rad]
   std::vector<float> heel_pitch_rate;  // its rate [rad/s] (it settles back on a spring)
   // Share of the swing height a standing blend takes away that is given back to this foot, 0..1
