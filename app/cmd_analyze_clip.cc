@@ -195,6 +195,21 @@ void print_library(const ClipSet& set) {
   std::printf("as a library (%s alone): %zu clips:", set.source.c_str(), lib->clips.size());
   for (const std::string& c : lib->clip_names()) std::printf(" %s", c.c_str());
   std::printf("\n");
+  // Captures below 60 fps are played from their upsampling (LocomotionClip::played).
+  int upsampled = 0;
+  float from_fps = 0.0f, to_fps = 0.0f;
+  for (const LocomotionClip& c : lib->clips) {
+    if (c.played.num_frames == 0) continue;
+    ++upsampled;
+    from_fps = c.clip.fps;
+    to_fps = c.played.fps;
+  }
+  if (upsampled > 0) {
+    std::printf(
+        "  played at %g fps: %d clip(s) captured at %g fps, upsampled on a monotone cubic "
+        "through their frames (analysis and contacts use the captured frames)\n",
+        to_fps, upsampled, from_fps);
+  }
   for (const std::string& d : describe_doubts(*lib)) std::printf("  doubtful: %s\n", d.c_str());
   for (const std::string& g : describe_gaps(*lib, MediatorParams{})) {
     std::printf("  gap: %s\n", g.c_str());

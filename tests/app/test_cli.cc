@@ -56,6 +56,21 @@ TEST(Cli, AnalyzeClipCoversEverySharedClip) {
   EXPECT_EQ(by_name["Walk_Loop"]["joints"].get<int>(), 53);
 }
 
+// analyze-clip says how a capture below 60 fps is played (upsampled, its analysis on the captured
+// frames), and says nothing of it for a 120 fps capture.
+TEST(Cli, AnalyzeClipSaysWhichClipsArePlayedUpsampled) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
+  CommandResult r =
+      run("analyze-clip " + test::data_path("clips/bvh/more/cmu_16_15_walk_mrl30.bvh"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("played at 60 fps: 1 clip(s) captured at 30 fps, upsampled"),
+            std::string::npos)
+      << r.out;
+  r = run("analyze-clip " + test::data_path("clips/bvh/cmu_07_01_walk.bvh"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("upsampled"), std::string::npos) << r.out;
+}
+
 TEST(Cli, AnalyzeClipNamesTheBrokenFile) {
   const std::string bad = test::source_path("tests/data/bad/channel_count.bvh");
   const CommandResult r = run("analyze-clip " + bad);
