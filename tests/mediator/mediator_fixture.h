@@ -5,6 +5,7 @@
 #include <initializer_list>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "animation/clip_library.h"
 #include "animation/procedural.h"
@@ -107,6 +108,21 @@ inline RunResult run_scripted(const LocomotionLibrary& lib, std::vector<Script> 
   out.sanitised = pipeline.mediator().num_sanitised();
   return out;
 }
+
+// n agents in a row 1.5 m apart along x (ids 1..n), at rest and facing +z: the arrays a test feeds
+// the mediator frame by frame, moving the agents itself.
+struct AgentRow {
+  std::vector<uint32_t> ids;
+  std::vector<glm::vec2> p, v;
+  std::vector<float> th;
+  explicit AgentRow(int n) : ids(n), p(n), v(n), th(n, 0.0f) {
+    for (int i = 0; i < n; ++i) {
+      ids[i] = static_cast<uint32_t>(i + 1);
+      p[i] = glm::vec2(1.5f * static_cast<float>(i), 0.0f);
+    }
+  }
+  AgentFrame frame() const { return AgentFrame{ids, p, v, th}; }
+};
 
 inline Script straight(glm::vec2 start, glm::vec2 velocity) {
   return {start, [velocity](double) { return velocity; }, nullptr};

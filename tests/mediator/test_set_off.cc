@@ -184,13 +184,7 @@ TEST(SetOff, ASuddenStopLowersALiftedFootAsTheWalkDoes) {
   const int frames = walk_frames + kAgents * 2 + static_cast<int>(2.0f / kDt);
   Mediator m(lib, MediatorParams{}, kAgents);
   PoseSynthesizer ps(lib, kAgents, false);
-  std::vector<uint32_t> ids(kAgents);
-  std::vector<glm::vec2> p(kAgents), v(kAgents);
-  std::vector<float> th(kAgents, 0.0f);
-  for (int i = 0; i < kAgents; ++i) {
-    ids[i] = static_cast<uint32_t>(i + 1);
-    p[i] = glm::vec2(1.5f * static_cast<float>(i), 0.0f);
-  }
+  test::AgentRow row(kAgents);
   const Skeleton& sk = *lib.skeleton;
   std::vector<float> last(kAgents * 2, 0.0f);
   float walking_drop = 0.0f, stopping_drop = 0.0f;
@@ -198,10 +192,10 @@ TEST(SetOff, ASuddenStopLowersALiftedFootAsTheWalkDoes) {
   for (int f = 0; f < frames; ++f) {
     for (int i = 0; i < kAgents; ++i) {
       const bool stopped = f >= walk_frames + 2 * i;  // agent i stops 2 frames after agent i-1
-      v[i] = stopped ? glm::vec2(0.0f) : glm::vec2(0.0f, speed);
-      p[i] += v[i] * kDt;
+      row.v[i] = stopped ? glm::vec2(0.0f) : glm::vec2(0.0f, speed);
+      row.p[i] += row.v[i] * kDt;
     }
-    ASSERT_TRUE(m.plan(AgentFrame{ids, p, v, th}, kDt).ok());
+    ASSERT_TRUE(m.plan(row.frame(), kDt).ok());
     ps.run(m.plans(), kAgents, m.params(), kDt);
     for (int i = 0; i < kAgents; ++i) {
       const int slot = m.plans().slot_of_agent[i];

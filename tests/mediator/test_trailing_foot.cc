@@ -36,23 +36,17 @@ TEST(TrailingFoot, WaitsNoLongerThanADoubleSupportForALeadingFootDrawnFlat) {
   constexpr int kAgents = 16;
   Mediator m(*lib, params, kAgents);
   PoseSynthesizer ps(*lib, kAgents, false);
-  std::vector<uint32_t> ids(kAgents);
-  std::vector<glm::vec2> p(kAgents), v(kAgents);
-  std::vector<float> th(kAgents, 0.0f);
-  for (int i = 0; i < kAgents; ++i) {
-    ids[i] = static_cast<uint32_t>(i + 1);
-    p[i] = glm::vec2(1.5f * static_cast<float>(i), 0.0f);
-  }
+  test::AgentRow row(kAgents);
   std::vector<int> held(kAgents * 2, 0);
   int longest = 0, lifted_frames = 0;
   for (int f = 0; f < static_cast<int>(8.0f / kDt); ++f) {
     for (int i = 0; i < kAgents; ++i) {
       const float t = static_cast<float>(f) * kDt;
       const float speed = 0.1f + 0.25f * (1.0f + std::sin(0.8f * t + static_cast<float>(i)));
-      v[i] = glm::vec2(0.0f, speed);
-      p[i] += v[i] * kDt;
+      row.v[i] = glm::vec2(0.0f, speed);
+      row.p[i] += row.v[i] * kDt;
     }
-    ASSERT_TRUE(m.plan(AgentFrame{ids, p, v, th}, kDt).ok());
+    ASSERT_TRUE(m.plan(row.frame(), kDt).ok());
     ps.run(m.plans(), kAgents, m.params(), kDt);
     if (f < static_cast<int>(1.0f / kDt)) continue;  // settling in
     for (int i = 0; i < kAgents; ++i) {
