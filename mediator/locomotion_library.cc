@@ -453,8 +453,6 @@ void raise_clip(LocomotionClip* lc, float dy) {
   }
 }
 
-// A standing clip taken from the frame of a gait clip where both feet are planted closest
-// together, for libraries without an idle (e.g. a walk and a run).
 // How many times a clip is upsampled for playback (LocomotionClip::played): a capture below
 // kPlaybackFps to at least that (24 fps to 72, 30 fps to 60), at most kMaxUpsampling times (a
 // file that claims a frame every few seconds is not made into millions of frames); authored keys
@@ -467,6 +465,8 @@ int playback_upsampling(const Clip& c) {
   return std::min(kMaxUpsampling, static_cast<int>(std::ceil(kPlaybackFps / c.fps - 1e-3f)));
 }
 
+// A standing clip taken from the frame of a gait clip where both feet are planted closest
+// together, for libraries without an idle (e.g. a walk and a run).
 LocomotionClip synthesise_idle(const LocomotionClip& gait, const Skeleton& sk) {
   const Clip& g = gait.clip;
   std::vector<glm::mat4> model(sk.num_joints());

@@ -10,13 +10,12 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
 #include "animation/clip.h"
 #include "animation/pose_jobs.h"
 #include "animation/skeleton.h"
-#include "tests/animation/joint_positions.h"
+#include "tests/animation/model_pose.h"
 
 namespace gk {
 namespace {
@@ -147,11 +146,9 @@ TEST(Upsample, TheJointsVelocityNoLongerJumpsAtEveryCapturedFrame) {
   std::vector<glm::vec3> tip_lin, tip_up, tip_true;
   std::vector<glm::quat> rot(2);
   std::vector<glm::vec3> trans(2);
-  std::vector<glm::mat4> model(2);
   auto tip = [&](const std::vector<glm::quat>& r, const std::vector<glm::vec3>& t) {
-    const glm::mat4 m = glm::translate(glm::mat4(1.0f), t[0]) * glm::mat4_cast(r[0]) *
-                        glm::translate(glm::mat4(1.0f), t[1]) * glm::mat4_cast(r[1]);
-    return glm::vec3(m * glm::vec4(0.0f, -0.4f, 0.0f, 1.0f));
+    return glm::vec3(test::model_pose(sk, r.data(), t.data())[1] *
+                     glm::vec4(0.0f, -0.4f, 0.0f, 1.0f));
   };
   for (int f = 0; f < u.num_frames; ++f) {
     const float t = static_cast<float>(f) / 60.0f;

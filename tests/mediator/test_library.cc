@@ -12,6 +12,7 @@
 #include "animation/pose_jobs.h"
 #include "animation/procedural.h"
 #include "tests/animation/clip_transforms.h"
+#include "tests/animation/model_pose.h"
 #include "tests/mediator/mediator_fixture.h"
 #include "tests/test_data.h"
 
@@ -330,17 +331,10 @@ std::vector<glm::vec3> toe_at_60hz(const Clip& c, const Skeleton& sk, Side side)
   const int J = sk.num_joints();
   std::vector<glm::quat> rot(J);
   std::vector<glm::vec3> trans(J);
-  std::vector<glm::mat4> model(J);
   std::vector<glm::vec3> out;
   for (int f = 0; f / 60.0f <= c.duration_s(); ++f) {
     SampleClipJob{&c, f / 60.0f, rot, trans}.run();
-    LocalToModelJob job;
-    job.skeleton = &sk;
-    job.rotations = rot;
-    job.translations = trans;
-    job.out_model = model;
-    job.run();
-    out.push_back(translation_of(model[sk.toe(side)]));
+    out.push_back(translation_of(test::model_pose(sk, rot.data(), trans.data())[sk.toe(side)]));
   }
   return out;
 }
