@@ -23,7 +23,8 @@ bool usable(const glm::vec3& v) { return usable(v.x) && usable(v.y) && usable(v.
 // True when step_foot_lock has some input value to replace (sanitise).
 bool needs_sanitising(const FootLockInput& in) {
   return !usable(in.anim_toe_prev) || !usable(in.drawn_toe_prev) || !usable(in.floor_toe_m) ||
-         !std::isfinite(in.swing_progress) || !std::isfinite(in.still_speed_m_s);
+         !usable(in.stand_toe_y) || !std::isfinite(in.swing_progress) ||
+         !std::isfinite(in.still_speed_m_s);
 }
 
 // The input with unusable values replaced as step_foot_lock documents (anim_toe is usable).
@@ -31,6 +32,7 @@ void sanitise(FootLockInput& out) {
   if (!usable(out.anim_toe_prev)) out.anim_toe_prev = out.anim_toe;
   if (!usable(out.drawn_toe_prev)) out.drawn_toe_prev = out.anim_toe;
   if (!usable(out.floor_toe_m)) out.floor_toe_m = std::numeric_limits<float>::lowest();
+  if (!usable(out.stand_toe_y)) out.stand_toe_y = out.floor_toe_m;
   if (!std::isfinite(out.swing_progress)) out.swing_progress = 0.0f;
   if (!std::isfinite(out.still_speed_m_s)) out.still_speed_m_s = 0.0f;
 }
@@ -46,13 +48,21 @@ void sanitise(FootLockInput& out) {
 // a frame or two, snapping the knee). Alone on the ground in a walk, the ball bears the weight and
 // stays down (the heel rises about it). It rises as fast as the clip's does this frame;
 // what it has to catch up beyond that (the clip's toe already higher when the other foot is
-// pinned) goes through the settling offset, so the drawn toe never jumps.
+// pinned) goes through the settling offset, so the drawn toe never jumps. While the standing clips
+// vote the feet (a creeping pedestrian) the pin stands where they have the toe, and a pin above
+// that (a push-off the gait clips began) comes down to it through the settling offset as well.
 void pin_height(FootLock& s, const FootLockInput& in) {
   const float clip_y = std::max(in.floor_toe_m, in.anim_toe.y);
-  if ((in.other_locked || in.flight) && clip_y > s.target.y) {
+  if (((in.other_locked && !in.standing_votes) || in.flight) && clip_y > s.target.y) {
     const float clip_rise = std::max(0.0f, in.anim_toe.y - in.anim_toe_prev.y);
     s.offset.y -= std::max(0.0f, clip_y - s.target.y - clip_rise);
     s.target.y = clip_y;
+    return;
+  }
+  const float stand_y = std::max(in.floor_toe_m, in.stand_toe_y);
+  if (in.standing_votes && s.target.y > stand_y) {
+    s.offset.y += s.target.y - stand_y;
+    s.target.y = stand_y;
     return;
   }
   s.target.y = std::min(s.target.y, clip_y);

@@ -86,6 +86,14 @@ struct FootLockInput {
   // it back to the clip's foot, so a drift alone starts no re-planting step (a step would lift it
   // while the other foot may still be rolling down onto its ball: both off the ground).
   bool walking = false;
+  // The standing clips vote the feet (the gait clips and any start or stop carry less than
+  // kGaitVoteWeight of the blend: a pedestrian creeping, or coming to rest). Their "both feet
+  // down" is where a pinned toe stands: on the floor where they have it (stand_toe_y, never below
+  // the floor), not raised with what the gait clips' swing adds to the blend (nor the height the
+  // blend gives back to a stepping foot). A pinned toe rises with the clips' only while the clips
+  // that step the feet vote them: then it is a push-off.
+  bool standing_votes = false;
+  float stand_toe_y = 0.0f;  // where the standing clips have this toe [m]
   // The body runs (clips with a flight phase, no double support, at or above the walk-run speed;
   // pose synthesis sets it): the foot pushes off on its toes into the air, not onto the other
   // foot, and a pinned ball follows the clips' up as well as down all through the stance (held
@@ -145,7 +153,8 @@ struct FootLockStep {
 // 1e6 m, a dt_s that is not a finite positive number) never reaches the state: without a usable
 // clip toe or time step the foot keeps its state and its last goal (a fresh one is a default
 // FootLock drawn at the origin); an unusable previous toe counts as the clip's toe this frame, an
-// unusable floor as none, an unusable swing progress or still speed as 0.
+// unusable floor as none, an unusable standing clips' toe as the floor, an unusable swing progress
+// or still speed as 0.
 FootLockStep step_foot_lock(const FootLock& state, const FootLockInput& in,
                             const FootLockParams& params, float dt_s);
 

@@ -756,6 +756,29 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                           glide_halflife_s(P)};
   glm::vec3 goal[2], anim_toe[2], anim_vel[2];
   bool pinned[2] = {false, false};
+  // The clips that step the feet vote them from this share on (as the mediator's contacts pass);
+  // below it the standing clips do, and where they have the toes is where a pinned toe stands.
+  float moving_w = 0.0f, stand_w = 0.0f, stand_toe[2] = {0.0f, 0.0f};
+  for (int k = 0; k < kMaxBlendLayers; ++k) {
+    const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
+    if (!(w > 0.0f)) continue;
+    const LocomotionClip& c = library_.clips[pl.layer_clip[slot * kMaxBlendLayers + k]];
+    if (c.gait || c.transition) {
+      moving_w += w;
+      continue;
+    }
+    const float ft = pl.layer_time_s[slot * kMaxBlendLayers + k] * c.clip.fps;
+    const int f0 = static_cast<int>(std::floor(ft));
+    const float fu = ft - static_cast<float>(f0);
+    stand_w += w;
+    for (int s = 0; s < 2; ++s) {
+      const std::vector<float>& h = c.toe_height_m[s];
+      if (h.empty()) continue;
+      const float a = h[c.wrap_frame(f0)], b = h[c.wrap_frame(f0 + 1)];
+      stand_toe[s] += w * (a + fu * (b - a) + c.toe_floor_m[s]);
+    }
+  }
+  const bool standing_votes = moving_w < kGaitVoteWeight;
   if (pl.fresh[slot]) {
     // A new agent's feet start free: the first foot's rules read the other's state, which is
     // otherwise still the slot's previous agent's.
@@ -770,8 +793,11 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     // takes away is given back in full once the gait clips step the feet (they vote the
     // contacts from kGaitVoteWeight), fading in below that. Otherwise (both feet free: a start,
     // a re-plant, a clip whose trailing toe leaves early) only as much as the blend walks, so the
-    // body never hangs on two lifted feet. The share moves toward its goal over the lock's
-    // release time, so the toe never jumps.
+    // body never hangs on two lifted feet. A foot pinned while the standing clips vote the feet
+    // (a creeper; an agent about to set off) is given none: it stands on the floor
+    // (FootLockInput::standing_votes), and given the walk's height then, its clips' toe was
+    // centimetres up when the walk took the vote, and the released foot snapped up to it. The
+    // share moves toward its goal over the lock's release time, so the toe never jumps.
     // Made whole in registers and stored once: a vector stored and then changed in memory is
     // read back (below) from two stores, which the load cannot take from the store buffer, and
     // it waits for every store before it (a streamed palette's too) to drain.
@@ -791,8 +817,10 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const bool other_carries =
         !letting_go &&
         locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state == FootLockState::kLocked;
+    const bool held_down =
+        standing_votes && locks_.lock[k].state == FootLockState::kLocked && !pl.fresh[slot];
     const float share_goal =
-        smoothstep01(other_carries ? gw / kGaitVoteWeight : 2.0f * gw);
+        held_down ? 0.0f : smoothstep01(other_carries ? gw / kGaitVoteWeight : 2.0f * gw);
     float& share = locks_.lift_share[k];
     share = pl.fresh[slot] ? share_goal
                            : approach(share, share_goal, dt / std::max(P.lock_release_s, dt));
@@ -809,6 +837,9 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const FootLockState other = locks_.lock[static_cast<size_t>(slot) * 2 + (1 - side)].state;
     in.other_locked = !letting_go && other == FootLockState::kLocked;
     in.walking = pl.gait_weight[slot] >= kGaitVoteWeight;
+    in.standing_votes = standing_votes;
+    in.stand_toe_y =
+        stand_w > 0.0f ? stand_toe[side] / stand_w + root[3].y : library_.planted_toe_m[side];
     // Running: clips with a flight phase, at a running speed. Below the walk-run speed a person
     // walks (GAIT.md), whatever the clips (a jog slowed for walkers, blended with the standing
     // pose, swings its feet low): the push-off is onto the other foot, and a pinned ball that

@@ -195,6 +195,63 @@ TEST(FootLockTransition, APinnedToeRisesWithTheClipsOnlyWhileTheOtherFootIsPinne
   EXPECT_NEAR(last_y, anim.y, 1e-3f);
 }
 
+// While the standing clips vote the feet (a creeping pedestrian), the clips' toe rising under a
+// pinned foot is the walk's small share swinging it, not a push-off: with the other foot pinned,
+// the pin stays where it is. One the gait clips had raised (6 cm, a push-off) when the standing
+// clips took the vote comes down onto where they have the toe (4 mm above the floor) through the
+// settling offset: no jump in the frame the vote changes, then the offset's critically damped
+// decay, x0 (1 + y t) e^(-y t), to within a millimetre 0.3 s on.
+TEST(FootLockTransition, WhileTheStandingClipsVoteAPinnedToeStandsWhereTheyHaveIt) {
+  const FootLockParams p;
+  const glm::vec3 pin(0.2f, kFloor, 0.1f);
+  const float stand_y = kFloor + 0.004f;
+  {
+    FootLock s = locked_at(pin);
+    glm::vec3 anim = pin;
+    for (int f = 1; f <= 12; ++f) {
+      const glm::vec3 prev = anim;
+      anim.y += f <= 8 ? 0.01f : -0.01f;
+      FootLockInput in = input(anim, prev, s.last_goal);
+      in.hold = true;
+      in.other_locked = true;
+      in.standing_votes = true;
+      in.stand_toe_y = stand_y;
+      const FootLockStep next = step_foot_lock(s, in, p, kDt);
+      ASSERT_EQ(next.state.state, FootLockState::kLocked) << f;
+      EXPECT_EQ(next.goal, pin) << f;
+      s = next.state;
+    }
+  }
+  const float raised = kFloor + 0.06f;
+  FootLock s = locked_at(glm::vec3(pin.x, raised, pin.z));
+  const glm::vec3 anim(pin.x + 0.01f, kFloor + 0.08f, pin.z);  // the blend's toe, above both
+  for (int f = 1; f <= 18; ++f) {
+    FootLockInput in = input(anim, anim, s.last_goal);
+    in.hold = true;
+    in.other_locked = true;
+    in.standing_votes = true;
+    in.stand_toe_y = stand_y;
+    const FootLockStep next = step_foot_lock(s, in, p, kDt);
+    ASSERT_EQ(next.state.state, FootLockState::kLocked) << f;
+    EXPECT_EQ(next.goal.x, pin.x) << f;
+    EXPECT_EQ(next.goal.z, pin.z) << f;
+    EXPECT_NEAR(next.state.target.y, stand_y, 1e-7f) << f;
+    const double expected =
+        stand_y + settled(raised - stand_y, p.release_halflife_s, (f - 1) * double{kDt});
+    EXPECT_NEAR(next.goal.y, expected, 1e-5) << f;
+    s = next.state;
+  }
+  EXPECT_NEAR(s.last_goal.y, stand_y, 1e-3f);
+  // Below the floor the standing clips' toe is taken as the floor.
+  FootLock low = locked_at(glm::vec3(pin.x, raised, pin.z));
+  FootLockInput in = input(anim, anim, low.last_goal);
+  in.hold = true;
+  in.other_locked = true;
+  in.standing_votes = true;
+  in.stand_toe_y = kFloor - 0.03f;
+  EXPECT_NEAR(step_foot_lock(low, in, p, kDt).state.target.y, kFloor, 1e-7f);
+}
+
 TEST(FootLockTransition, PlantPinsWhereTheFootWasDrawn) {
   // plant_foot alone: drawn last at D (5 cm up), the clip's toe at 3 cm, the floor at 2 cm: the pin
   // is D's x, z at min(5, 3) = 3 cm, and the 2 cm it was drawn above that is the settling offset.
@@ -466,7 +523,7 @@ TEST(FootLockTransition, NaNInputGivesADefinedStateAndNoNaN) {
   states[2] = release_foot_lock(states[1], pin, glm::vec3(0.0f), a, glm::vec3(0.0f));
   states[3] = start_foot_step(states[1], pin);
   for (const FootLock& s : states) {
-    for (int field = 0; field < 7; ++field) {
+    for (int field = 0; field < 8; ++field) {
       for (bool plant : {false, true}) {
         FootLockInput in = input(a, a - glm::vec3(0.01f, 0.0f, 0.0f), pin);
         in.plant = in.hold = plant;
@@ -493,6 +550,10 @@ TEST(FootLockTransition, NaNInputGivesADefinedStateAndNoNaN) {
             break;
           case 6:
             dt = kNaN;
+            break;
+          case 7:
+            in.standing_votes = true;
+            in.stand_toe_y = kNaN;
             break;
         }
         const FootLockStep next = step_foot_lock(s, in, p, dt);

@@ -223,5 +223,60 @@ TEST(SetOff, ASuddenStopLowersALiftedFootAsTheWalkDoes) {
       << stopping_drop << " m";
 }
 
+// Standing agents that set off, one every few frames, at the accelerations a simulator's feedback
+// allows (MediatorParams::max_accel_m_s2): the first foot leaves the floor no faster than the walk
+// lifts a foot (within METRICS.md's factor of two for limb pops). While the standing clip votes the
+// feet (the walk still under a quarter of the blend) a pinned toe stays on the floor and is given
+// none of the walk's swing height back; gave it back, the clips' toe was centimetres up when the
+// walk took the vote, and the released foot caught up with it in a frame or two (a 30 fps take
+// alone: 2.5 cm in the release's frame, the knee snapping).
+TEST(SetOff, TheFirstFootLeavesTheFloorAsTheWalkLiftsIt) {
+  GK_REQUIRE_DATA("clips/bvh/more/cmu_16_15_walk_mrl30.bvh");
+  auto taken = test::load_data_library({"clips/bvh/more/cmu_16_15_walk_mrl30.bvh"});
+  ASSERT_TRUE(taken.ok()) << taken.message();
+  const LocomotionLibrary* libraries[] = {&test::builtin_library(), &*taken};
+  for (const LocomotionLibrary* lib : libraries) {
+    const LocomotionClip& walk = lib->clips[lib->groups[lib->forward_group].clips.front()];
+    const float speed = walk.speed_m_s;
+    const MediatorParams params;
+    constexpr int kAgents = 16;
+    const int stand_frames = static_cast<int>(2.0f / kDt);
+    const int frames = stand_frames + kAgents * 3 + static_cast<int>(3.0f / kDt);
+    Mediator m(*lib, params, kAgents);
+    PoseSynthesizer ps(*lib, kAgents, false);
+    test::AgentRow row(kAgents);
+    const Skeleton& sk = *lib->skeleton;
+    std::vector<float> last(kAgents * 2, 0.0f), v(kAgents, 0.0f);
+    float walking_rise = 0.0f, setting_off_rise = 0.0f;
+    for (int f = 0; f < frames; ++f) {
+      for (int i = 0; i < kAgents; ++i) {
+        // Agent i sets off 3 frames after agent i-1, speeding up at the feedback's limit.
+        if (f >= stand_frames + 3 * i) v[i] = std::min(speed, v[i] + params.max_accel_m_s2 * kDt);
+        row.v[i] = glm::vec2(0.0f, v[i]);
+        row.p[i] += row.v[i] * kDt;
+      }
+      ASSERT_TRUE(m.plan(row.frame(), kDt).ok());
+      ps.run(m.plans(), kAgents, m.params(), kDt);
+      for (int i = 0; i < kAgents; ++i) {
+        const int slot = m.plans().slot_of_agent[i];
+        const float since_s = static_cast<float>(f - stand_frames - 3 * i) * kDt;
+        for (int s = 0; s < 2; ++s) {
+          const float y = translation_of(ps.world(slot)[sk.toe(static_cast<Side>(s))]).y;
+          const float rise = y - last[i * 2 + s];
+          last[i * 2 + s] = y;
+          if (f < static_cast<int>(1.0f / kDt)) continue;  // settling in
+          if (since_s >= 0.0f && since_s < 1.5f)
+            setting_off_rise = std::max(setting_off_rise, rise);
+          if (since_s >= 2.0f) walking_rise = std::max(walking_rise, rise);
+        }
+      }
+    }
+    ASSERT_GT(walking_rise, 0.002f) << "the walk lifts its feet";
+    EXPECT_LE(setting_off_rise, 2.0f * walking_rise)
+        << walk.clip.name << ": fastest rise of a toe in a frame: walking " << walking_rise
+        << " m, setting off " << setting_off_rise << " m";
+  }
+}
+
 }  // namespace
 }  // namespace gk
