@@ -36,11 +36,19 @@ TEST(Scenario, ShipsTheSixScenarios) {
   }
 }
 
-// Every shipped scenario loads and expands to 1, 10 and 500 agents that start inside the bounds,
-// apart from each other and clear of every wall, with a goal to walk to.
+// Every shipped scenario (and those of the README's figures, in docs/) loads and expands to 1, 10
+// and 500 agents that start inside the bounds, apart from each other and clear of every wall, with
+// a goal to walk to.
 TEST(Scenario, EveryScenarioExpandsTo1_10_500Agents) {
-  for (const auto& e : std::filesystem::directory_iterator(scenarios())) {
-    if (e.path().extension() != ".json") continue;
+  std::vector<std::filesystem::path> files;
+  for (const std::string& dir : {scenarios(), test::source_path("docs")}) {
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+      if (e.path().extension() == ".json") files.push_back(e.path());
+    }
+  }
+  ASSERT_GE(files.size(), 9u);
+  for (const std::filesystem::path& path : files) {
+    const auto e = std::filesystem::directory_entry(path);
     SCOPED_TRACE(e.path().string());
     auto loaded = load_scenario(e.path().string());
     ASSERT_TRUE(loaded.ok()) << loaded.message();
