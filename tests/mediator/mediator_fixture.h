@@ -2,6 +2,7 @@
 // Runs a scripted crowd through CrowdPipeline (mediator, feedback, pose synthesis) and returns the
 // METRICS.md report.
 
+#include <cmath>
 #include <initializer_list>
 #include <memory>
 #include <string>
@@ -123,6 +124,30 @@ struct AgentRow {
   }
   AgentFrame frame() const { return AgentFrame{ids, p, v, th}; }
 };
+
+// Pedestrians creeping and walking slowly in a row (0.1-0.6 m/s, speeding up and slowing down,
+// each on its own phase), planned and posed for `seconds` at 60 Hz; after the first second
+// (settling in) `on_frame(mediator, poses)` sees each frame. False if a plan failed.
+template <typename OnFrame>
+bool creep_row(const LocomotionLibrary& lib, int agents, float seconds, OnFrame on_frame) {
+  constexpr float kDt = 1.0f / 60.0f;
+  const MediatorParams params;
+  Mediator m(lib, params, agents);
+  PoseSynthesizer ps(lib, agents, false);
+  AgentRow row(agents);
+  for (int f = 0; f < static_cast<int>(seconds / kDt); ++f) {
+    for (int i = 0; i < agents; ++i) {
+      const float t = static_cast<float>(f) * kDt;
+      const float speed = 0.1f + 0.25f * (1.0f + std::sin(0.8f * t + static_cast<float>(i)));
+      row.v[i] = glm::vec2(0.0f, speed);
+      row.p[i] += row.v[i] * kDt;
+    }
+    if (!m.plan(row.frame(), kDt).ok()) return false;
+    ps.run(m.plans(), agents, m.params(), kDt);
+    if (f >= static_cast<int>(1.0f / kDt)) on_frame(static_cast<const Mediator&>(m), ps);
+  }
+  return true;
+}
 
 inline Script straight(glm::vec2 start, glm::vec2 velocity) {
   return {start, [velocity](double) { return velocity; }, nullptr};

@@ -205,18 +205,23 @@ TEST(FootLockTransition, WhileTheStandingClipsVoteAPinnedToeStandsWhereTheyHaveI
   const FootLockParams p;
   const glm::vec3 pin(0.2f, kFloor, 0.1f);
   const float stand_y = kFloor + 0.004f;
+  // A frame's input with the clips keeping the weight on the foot, the other foot pinned, and the
+  // standing clips voting the feet.
+  auto standing = [&](const glm::vec3& anim, const glm::vec3& prev, const glm::vec3& drawn) {
+    FootLockInput in = input(anim, prev, drawn);
+    in.hold = true;
+    in.other_locked = true;
+    in.standing_votes = true;
+    in.stand_toe_y = stand_y;
+    return in;
+  };
   {
     FootLock s = locked_at(pin);
     glm::vec3 anim = pin;
     for (int f = 1; f <= 12; ++f) {
       const glm::vec3 prev = anim;
       anim.y += f <= 8 ? 0.01f : -0.01f;
-      FootLockInput in = input(anim, prev, s.last_goal);
-      in.hold = true;
-      in.other_locked = true;
-      in.standing_votes = true;
-      in.stand_toe_y = stand_y;
-      const FootLockStep next = step_foot_lock(s, in, p, kDt);
+      const FootLockStep next = step_foot_lock(s, standing(anim, prev, s.last_goal), p, kDt);
       ASSERT_EQ(next.state.state, FootLockState::kLocked) << f;
       EXPECT_EQ(next.goal, pin) << f;
       s = next.state;
@@ -226,12 +231,7 @@ TEST(FootLockTransition, WhileTheStandingClipsVoteAPinnedToeStandsWhereTheyHaveI
   FootLock s = locked_at(glm::vec3(pin.x, raised, pin.z));
   const glm::vec3 anim(pin.x + 0.01f, kFloor + 0.08f, pin.z);  // the blend's toe, above both
   for (int f = 1; f <= 18; ++f) {
-    FootLockInput in = input(anim, anim, s.last_goal);
-    in.hold = true;
-    in.other_locked = true;
-    in.standing_votes = true;
-    in.stand_toe_y = stand_y;
-    const FootLockStep next = step_foot_lock(s, in, p, kDt);
+    const FootLockStep next = step_foot_lock(s, standing(anim, anim, s.last_goal), p, kDt);
     ASSERT_EQ(next.state.state, FootLockState::kLocked) << f;
     EXPECT_EQ(next.goal.x, pin.x) << f;
     EXPECT_EQ(next.goal.z, pin.z) << f;
@@ -244,10 +244,7 @@ TEST(FootLockTransition, WhileTheStandingClipsVoteAPinnedToeStandsWhereTheyHaveI
   EXPECT_NEAR(s.last_goal.y, stand_y, 1e-3f);
   // Below the floor the standing clips' toe is taken as the floor.
   FootLock low = locked_at(glm::vec3(pin.x, raised, pin.z));
-  FootLockInput in = input(anim, anim, low.last_goal);
-  in.hold = true;
-  in.other_locked = true;
-  in.standing_votes = true;
+  FootLockInput in = standing(anim, anim, low.last_goal);
   in.stand_toe_y = kFloor - 0.03f;
   EXPECT_NEAR(step_foot_lock(low, in, p, kDt).state.target.y, kFloor, 1e-7f);
 }
