@@ -274,15 +274,20 @@ glm::vec3 releasing_foot(FootLock& s, const FootLockInput& in, const FootLockPar
   return goal;
 }
 
-// A re-planting step: lifted, carried and set down where the clip has the foot, as high as the
-// clips' own swing: the foot rises before it moves and stops moving before it lands (zero speed at
-// both ends, so nothing snaps). Landed, it is pinned there.
+// A re-planting step: lifted, carried and set down on the floor where the clip has the foot, as
+// high as the clips' own swing: the foot rises before it moves and stops moving before it lands
+// (zero speed at both ends, so nothing snaps). Landed, it is pinned there.
 glm::vec3 stepping_foot(FootLock& s, const FootLockInput& in, const FootLockParams& p, float dt) {
   const bool first = s.timer_s <= 0.0f;
   s.timer_s += dt;
   const float u = std::min(1.0f, s.timer_s / p.step_time_s);
   const float sn = std::sin(std::numbers::pi_v<float> * u);
-  glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, in.anim_toe.y), in.anim_toe.z);
+  // It is set down on the floor (where the standing clips have the toe, while they vote the
+  // feet), never at the blend's toe height: that is the walk's share swinging the foot, and a step
+  // set down there was pinned in the air.
+  float land_y = in.standing_votes ? in.stand_toe_y : in.floor_toe_m;
+  if (!usable(land_y)) land_y = in.anim_toe.y;  // no floor known: where the clip has the toe
+  glm::vec3 to(in.anim_toe.x, std::max(in.floor_toe_m, land_y), in.anim_toe.z);
   // Where it lands is chosen before it comes down: it follows the clip's foot while it is
   // carried, and is set down on the spot it was carried to (a body turning on the spot would
   // otherwise drag the landing foot along the ground). Where the clip's foot jumps (a blend

@@ -509,6 +509,27 @@ TEST(FootLockTransition, PinnedFootLeftBehindStepsFromItsPinAndReplantsAtTheClip
   ASSERT_EQ(s.state, FootLockState::kLocked);
   EXPECT_EQ(s.target, to);
   EXPECT_NEAR(s.timer_s, p.step_time_s, kDt + 1e-6f);
+  // The blend's toe 15 cm up (the walk's share swinging it), the standing clips voting the feet:
+  // the step is set down on the floor where the standing clips have the toe, not up there.
+  FootLock creeper = locked_at(pin);
+  FootLockInput lifted =
+      input(to + glm::vec3(0.0f, 0.15f, 0.0f), to + glm::vec3(0.0f, 0.15f, 0.0f), pin);
+  lifted.hold = lifted.other_locked = lifted.standing_votes = true;
+  lifted.stand_toe_y = kFloor + 0.003f;
+  for (int f = 0; f < 40 && (f == 0 || creeper.state == FootLockState::kStepping); ++f) {
+    creeper = step_foot_lock(creeper, lifted, p, kDt).state;
+  }
+  ASSERT_EQ(creeper.state, FootLockState::kLocked);
+  EXPECT_EQ(creeper.target, glm::vec3(to.x, kFloor + 0.003f, to.z));
+  // Nor, the gait clips voting, at their toe's height: a step (as pose synthesis starts one for a
+  // leg that cannot reach its pin) is set down on the floor.
+  FootLock reached = start_foot_step(locked_at(pin), pin);
+  lifted.standing_votes = false;
+  for (int f = 0; f < 40 && reached.state == FootLockState::kStepping; ++f) {
+    reached = step_foot_lock(reached, lifted, p, kDt).state;
+  }
+  ASSERT_EQ(reached.state, FootLockState::kLocked);
+  EXPECT_EQ(reached.target, to);
 }
 
 TEST(FootLockTransition, NaNInputGivesADefinedStateAndNoNaN) {
