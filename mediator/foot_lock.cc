@@ -32,7 +32,9 @@ void sanitise(FootLockInput& out) {
   if (!usable(out.anim_toe_prev)) out.anim_toe_prev = out.anim_toe;
   if (!usable(out.drawn_toe_prev)) out.drawn_toe_prev = out.anim_toe;
   if (!usable(out.floor_toe_m)) out.floor_toe_m = std::numeric_limits<float>::lowest();
-  if (!usable(out.stand_toe_y)) out.stand_toe_y = out.floor_toe_m;
+  if (!usable(out.stand_toe_y)) {
+    out.stand_toe_y = usable(out.floor_toe_m) ? out.floor_toe_m : out.anim_toe.y;
+  }
   if (!std::isfinite(out.swing_progress)) out.swing_progress = 0.0f;
   if (!std::isfinite(out.still_speed_m_s)) out.still_speed_m_s = 0.0f;
 }
@@ -59,7 +61,9 @@ void pin_height(FootLock& s, const FootLockInput& in) {
     s.target.y = clip_y;
     return;
   }
-  const float stand_y = std::max(in.floor_toe_m, in.stand_toe_y);
+  // (No higher than the clip's toe: below the standing clips' toe, the pin follows it down as it
+  // would otherwise; lowered only to their toe, it then dropped to the clip's in a frame.)
+  const float stand_y = std::min(std::max(in.floor_toe_m, in.stand_toe_y), clip_y);
   if (in.standing_votes && s.target.y > stand_y) {
     s.offset.y += s.target.y - stand_y;
     s.target.y = stand_y;

@@ -28,7 +28,7 @@
 //                             pinned flat (not on its heel)
 //   kStepping  -> kReleasing  release_foot_lock: the clips lift it before the step is done (the
 //                             step's velocity is carried on and shed: no jump to the clip's)
-//   kStepping  -> kLocked     the step has landed: pinned at the clip's toe
+//   kStepping  -> kLocked     the step has landed: pinned on the floor where the clip has the foot
 //   kReleasing -> kFree       the offset is shed
 //   any        -> kFree       fresh_foot_lock: an agent's first frame
 

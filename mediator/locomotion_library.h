@@ -85,6 +85,14 @@ struct LocomotionClip {
     if (i >= 0 && i < nf) return i;
     return clip.loops ? ((i % nf) + nf) % nf : (i < 0 ? 0 : nf - 1);
   }
+  // The toe's height in the clip [m] between frames f0 and f0 + 1 (fu of the way, in [0, 1);
+  // frames as wrap_frame has them): toe_height_m above toe_floor_m. toe_height_m[side] must not be
+  // empty.
+  float toe_y_at(int side, int f0, float fu) const {
+    const std::vector<float>& h = toe_height_m[side];
+    const float a = h[wrap_frame(f0)], b = h[wrap_frame(f0 + 1)];
+    return a + fu * (b - a) + toe_floor_m[side];
+  }
 };
 
 // A start (standing -> steady gait) or a stop (steady gait -> standing) found in a take, kept as

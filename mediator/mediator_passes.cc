@@ -884,9 +884,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
           wrap(ft >= 0.0f ? f0 + (fu >= 0.5f ? 1 : 0) : static_cast<int>(std::lround(ft)));
       for (int s = 0; s < 2; ++s) {
         if (clip.gait && !clip.toe_height_m[s].empty()) {
-          const auto& h = clip.toe_height_m[s];
-          const float hv = h[wrap(f0)] + fu * (h[wrap(f0 + 1)] - h[wrap(f0)]);
-          toe_gait[s] += lw[k] * (hv + clip.toe_floor_m[s]);
+          toe_gait[s] += lw[k] * clip.toe_y_at(s, f0, fu);
         }
       }
       if (gait_votes && !clip.gait && !clip.transition) continue;

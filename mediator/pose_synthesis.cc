@@ -758,7 +758,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
   bool pinned[2] = {false, false};
   // The clips that step the feet vote them from this share on (as the mediator's contacts pass);
   // below it the standing clips do, and where they have the toes is where a pinned toe stands.
-  float moving_w = 0.0f, stand_w = 0.0f, stand_toe[2] = {0.0f, 0.0f};
+  float moving_w = 0.0f, stand_w[2] = {0.0f, 0.0f}, stand_sum[2] = {0.0f, 0.0f};
   for (int k = 0; k < kMaxBlendLayers; ++k) {
     const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
     if (!(w > 0.0f)) continue;
@@ -770,15 +770,20 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     const float ft = pl.layer_time_s[slot * kMaxBlendLayers + k] * c.clip.fps;
     const int f0 = static_cast<int>(std::floor(ft));
     const float fu = ft - static_cast<float>(f0);
-    stand_w += w;
     for (int s = 0; s < 2; ++s) {
-      const std::vector<float>& h = c.toe_height_m[s];
-      if (h.empty()) continue;
-      const float a = h[c.wrap_frame(f0)], b = h[c.wrap_frame(f0 + 1)];
-      stand_toe[s] += w * (a + fu * (b - a) + c.toe_floor_m[s]);
+      if (c.toe_height_m[s].empty()) continue;
+      stand_w[s] += w;
+      stand_sum[s] += w * c.toe_y_at(s, f0, fu);
     }
   }
   const bool standing_votes = moving_w < kGaitVoteWeight;
+  // Where the standing clips have each toe, placed with the root, never below the floor (none
+  // known: the floor).
+  float stand_y[2];
+  for (int s = 0; s < 2; ++s) {
+    stand_y[s] = library_.planted_toe_m[s];
+    if (stand_w[s] > 0.0f) stand_y[s] = std::max(stand_y[s], stand_sum[s] / stand_w[s] + root[3].y);
+  }
   if (pl.fresh[slot]) {
     // A new agent's feet start free: the first foot's rules read the other's state, which is
     // otherwise still the slot's previous agent's.
@@ -838,8 +843,7 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
     in.other_locked = !letting_go && other == FootLockState::kLocked;
     in.walking = pl.gait_weight[slot] >= kGaitVoteWeight;
     in.standing_votes = standing_votes;
-    in.stand_toe_y =
-        stand_w > 0.0f ? stand_toe[side] / stand_w + root[3].y : library_.planted_toe_m[side];
+    in.stand_toe_y = stand_y[side];
     // Running: clips with a flight phase, at a running speed. Below the walk-run speed a person
     // walks (GAIT.md), whatever the clips (a jog slowed for walkers, blended with the standing
     // pose, swings its feet low): the push-off is onto the other foot, and a pinned ball that
