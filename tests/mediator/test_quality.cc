@@ -140,10 +140,12 @@ TEST(Quality, BottleneckJamOnDetourWithTheTwoCmuClips) {
 // support_hold, off by default): within the support-foot and limb-pop bounds, and the hold keeps
 // the support feet put (without it, a foot carrying the body alone is dragged or let go as the
 // body lurches on: its support skate is higher). The jam is chaotic (a millimetre anywhere sends
-// every agent on another path), so the skate is taken over three seeds' jams: held 0.0044 against
-// unheld 0.0066 (a single seed's held 0.0052, 0.0039 and 0.0041). The float the hold once kept
-// well down too is now mostly the quickened steps' doing (the rate pass lands the other foot before
-// the body leaves the support's reach), too close to be compared here.
+// every agent on another path), so the skate is taken over three seeds' jams: held 0.0038 against
+// unheld 0.0064 (per seed held 0.0032, 0.0048 and 0.0034; 0.0028 against 0.0060 before a creeper's
+// pinned feet came to stand on the floor, when one seed alone, as this test was, went over the
+// bound with a first version of that: 0.0055).
+// The float the hold once kept well down too is now mostly the quickened steps' doing (the rate
+// pass lands the other foot before the body leaves the support's reach), too close to compare.
 TEST(Quality, JammedBodiesAreHeldByTheirSupportFoot) {
   GK_REQUIRE_DATA("clips/gltf/ual_mannequin_quaternius.glb");
   auto lib = test::load_data_library({"clips/gltf/ual_mannequin_quaternius.glb"});
@@ -157,10 +159,8 @@ TEST(Quality, JammedBodiesAreHeldByTheirSupportFoot) {
     const MetricsReport apm = run_source(*a, *lib, MediatorMode::kApm, hold);
     const std::string what = "bottleneck detour mannequin, seed " + std::to_string(seed);
     expect_body_bounds(apm, false, what);
-    if (seed == 1) {
-      auto b = scenario_crowd("bottleneck", true, seed);
-      expect_feet_never_below_the_floor(apm, run_source(*b, *lib, MediatorMode::kNaive), what);
-    }
+    auto b = scenario_crowd("bottleneck", true, seed);
+    expect_feet_never_below_the_floor(apm, run_source(*b, *lib, MediatorMode::kNaive), what);
     EXPECT_LE(apm.feet.support_slide_cm_s, 2.0) << what;
     EXPECT_LE(apm.feet.limb_pop_rate, 1.0) << what;
     EXPECT_EQ(apm.pop_count, 0) << what;
