@@ -48,6 +48,11 @@ struct AnimationPlans {
   // blended with a standing pose swings lower, and pose synthesis gives a foot that is not pinned
   // the gait clips' own swing height back.
   std::vector<float> gait_toe_y[2];
+  // Toe height [m] (model space) the standing clips have at their time, or lowest() where none of
+  // them has toe heights; and 1 where they vote the feet (the gait clips and a start or stop carry
+  // under kGaitVoteWeight of the blend): a pinned toe then stands where they have it.
+  std::vector<float> stand_toe_y[2];
+  std::vector<uint8_t> standing_votes;
   // The voting clips' own ball speed over the ground at this frame's rate [m/s] (< 0: not known):
   // a foot has landed once its ball rests in the clips, though a blend's changing weights may
   // still move the drawn foot.

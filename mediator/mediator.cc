@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <tbb/blocked_range.h>
@@ -45,6 +46,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
     plans_.plant[s].assign(capacity, 1.0f);
     plans_.hold[s].assign(capacity, 1.0f);
     plans_.gait_toe_y[s].assign(capacity, 0.0f);
+    plans_.stand_toe_y[s].assign(capacity, std::numeric_limits<float>::lowest());
     plans_.clip_toe_speed[s].assign(capacity, -1.0f);
     plans_.swing_progress[s].assign(capacity, 0.0f);
     plans_.landing_s[s].assign(capacity, -1.0f);
@@ -53,6 +55,7 @@ Mediator::Mediator(const LocomotionLibrary& library, const MediatorParams& param
   plans_.phase.assign(capacity, 0.0f);
   plans_.blend_progress.assign(capacity, 1.0f);
   plans_.standing.assign(capacity, 1);
+  plans_.standing_votes.assign(capacity, 1);
   plans_.fresh.assign(capacity, 1);
   feedback_.has_feedback.assign(capacity, 0);
   feedback_.positions.assign(capacity, glm::vec2(0.0f));
@@ -295,8 +298,10 @@ Status Mediator::plan(const AgentFrame& frame, float dt_s, FeedbackPolicy policy
                  {pl.swing_progress[0], pl.swing_progress[1]},
                  {pl.landing_s[0], pl.landing_s[1]},
                  {pl.gait_toe_y[0], pl.gait_toe_y[1]},
+                 {pl.stand_toe_y[0], pl.stand_toe_y[1]},
                  {pl.clip_toe_speed[0], pl.clip_toe_speed[1]},
-                 pl.double_support});
+                 pl.double_support,
+                 pl.standing_votes});
   feedback_pass(
       crowd, honoured, sim_pos_, sim_vel_, sim_theta_, fed_speed_, pl.lower_yaw, pl.standing,
       pl.gait_weight, hold_, hold_scale_,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <tbb/parallel_for.h>
@@ -853,6 +854,7 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
     // swings.
     float plant[2] = {0.0f, 0.0f}, hold[2] = {0.0f, 0.0f}, vote_w = 0.0f;
     float toe_gait[2] = {0.0f, 0.0f}, swing[2] = {0.0f, 0.0f}, walk = 0.0f;
+    float toe_stand[2] = {0.0f, 0.0f}, stand_w[2] = {0.0f, 0.0f};
     float landing[2] = {0.0f, 0.0f}, landing_w[2] = {0.0f, 0.0f};
     float toe_speed[2] = {0.0f, 0.0f}, speed_w[2] = {0.0f, 0.0f};
     const float rate = playback_rate[slot], tr_rate = transition_rate[slot];
@@ -883,8 +885,12 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       const int f =
           wrap(ft >= 0.0f ? f0 + (fu >= 0.5f ? 1 : 0) : static_cast<int>(std::lround(ft)));
       for (int s = 0; s < 2; ++s) {
-        if (clip.gait && !clip.toe_height_m[s].empty()) {
+        if (clip.toe_height_m[s].empty() || clip.transition) continue;
+        if (clip.gait) {
           toe_gait[s] += lw[k] * clip.toe_y_at(s, f0, fu);
+        } else {
+          toe_stand[s] += lw[k] * clip.toe_y_at(s, f0, fu);
+          stand_w[s] += lw[k];
         }
       }
       if (gait_votes && !clip.gait && !clip.transition) continue;
@@ -930,9 +936,12 @@ void contacts_pass(const PassCrowd& c, std::span<const int16_t> layer_clip,
       out.swing_progress[s][slot] = swing[s] / std::max(vote_w, 1e-6f);
       out.landing_s[s][slot] = landing_w[s] > 0.0f ? landing[s] / landing_w[s] : -1.0f;
       out.gait_toe_y[s][slot] = gait_w > 0.0f ? toe_gait[s] / gait_w : 0.0f;
+      out.stand_toe_y[s][slot] =
+          stand_w[s] > 0.0f ? toe_stand[s] / stand_w[s] : std::numeric_limits<float>::lowest();
       out.clip_toe_speed[s][slot] = speed_w[s] > 0.0f ? toe_speed[s] / speed_w[s] : -1.0f;
     }
     out.double_support[slot] = walk / std::max(vote_w, 1e-6f);
+    out.standing_votes[slot] = gait_votes ? 0 : 1;
   });
 }
 

@@ -325,8 +325,10 @@ struct ContactPlans {
   std::span<float> swing_progress[2];  // 0 at lift-off, 1 at landing
   std::span<float> landing_s[2];       // when the clips land the foot [s] (< 0: none has it up)
   std::span<float> gait_toe_y[2];      // the gait clips' own toe height [m]
+  std::span<float> stand_toe_y[2];     // the standing clips' own toe height [m] (lowest(): none)
   std::span<float> clip_toe_speed[2];  // the voting clips' own ball speed [m/s] (< 0: unknown)
   std::span<float> double_support;     // share of the voting clips that walk, 0..1
+  std::span<uint8_t> standing_votes;   // 1: the standing clips vote the feet
 };
 // Reads the layers, the phase, the standing clip's and the transition's clocks, the share of
 // gait clips and the playback rates (the gait clips' and the transition's). Writes each layer's

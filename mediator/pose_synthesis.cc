@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -756,33 +757,15 @@ void PoseSynthesizer::lock_feet(const AnimationPlans& pl, const MediatorParams& 
                           glide_halflife_s(P)};
   glm::vec3 goal[2], anim_toe[2], anim_vel[2];
   bool pinned[2] = {false, false};
-  // The clips that step the feet vote them from this share on (as the mediator's contacts pass);
-  // below it the standing clips do, and where they have the toes is where a pinned toe stands.
-  float moving_w = 0.0f, stand_w[2] = {0.0f, 0.0f}, stand_sum[2] = {0.0f, 0.0f};
-  for (int k = 0; k < kMaxBlendLayers; ++k) {
-    const float w = pl.layer_weight[slot * kMaxBlendLayers + k];
-    if (!(w > 0.0f)) continue;
-    const LocomotionClip& c = library_.clips[pl.layer_clip[slot * kMaxBlendLayers + k]];
-    if (c.gait || c.transition) {
-      moving_w += w;
-      continue;
-    }
-    const float ft = pl.layer_time_s[slot * kMaxBlendLayers + k] * c.clip.fps;
-    const int f0 = static_cast<int>(std::floor(ft));
-    const float fu = ft - static_cast<float>(f0);
-    for (int s = 0; s < 2; ++s) {
-      if (c.toe_height_m[s].empty()) continue;
-      stand_w[s] += w;
-      stand_sum[s] += w * c.toe_y_at(s, f0, fu);
-    }
-  }
-  const bool standing_votes = moving_w < kGaitVoteWeight;
-  // Where the standing clips have each toe, placed with the root, never below the floor (none
-  // known: the floor).
+  // While the standing clips vote the feet (the mediator's contacts pass), a pinned toe stands
+  // where they have it, placed with the root and never below the floor (none known: the floor).
+  const bool standing_votes = pl.standing_votes[slot] != 0;
   float stand_y[2];
   for (int s = 0; s < 2; ++s) {
+    const float st = pl.stand_toe_y[s][slot];
     stand_y[s] = library_.planted_toe_m[s];
-    if (stand_w[s] > 0.0f) stand_y[s] = std::max(stand_y[s], stand_sum[s] / stand_w[s] + root[3].y);
+    if (st > std::numeric_limits<float>::lowest())
+      stand_y[s] = std::max(stand_y[s], st + root[3].y);
   }
   if (pl.fresh[slot]) {
     // A new agent's feet start free: the first foot's rules read the other's state, which is
